@@ -1,0 +1,34 @@
+#pragma once
+/// Error handling shared by every module (see CONVENTIONS.md, "three kinds of error"):
+/// - a caller's broken precondition throws romo::Error (ROMO_THROW_UNLESS / romo::Fail);
+/// - a broken internal invariant aborts (ROMO_DEMAND);
+/// - an expected run-time failure is a returned status or std::optional, never an exception.
+#include <stdexcept>
+#include <string>
+
+namespace romo {
+
+/// Thrown for bad input: the message names what was wrong (file, field, value).
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws romo::Error with @p message.
+[[noreturn]] void Fail(const std::string& message);
+
+namespace internal {
+[[noreturn]] void ThrowUnless(const char* condition, const char* func, const char* file, int line);
+[[noreturn]] void Abort(const char* condition, const char* func, const char* file, int line);
+}  // namespace internal
+}  // namespace romo
+
+#define ROMO_THROW_UNLESS(condition)                                                 \
+  do {                                                                               \
+    if (!(condition)) ::romo::internal::ThrowUnless(#condition, __func__, __FILE__, __LINE__); \
+  } while (false)
+
+#define ROMO_DEMAND(condition)                                                       \
+  do {                                                                               \
+    if (!(condition)) ::romo::internal::Abort(#condition, __func__, __FILE__, __LINE__); \
+  } while (false)

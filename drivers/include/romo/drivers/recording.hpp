@@ -1,0 +1,97 @@
+#pragma once
+/// Recordings are LCM log files (lcm-logger / lcm-logplayer work on them). Channels:
+///   ROMO_CALIBRATION        romo_lcm.calibration_t (YAML text), written first
+///   ROMO_STEREO_RIG<k>      romo_lcm.stereo_frame_t
+///   ROMO_RGBD               romo_lcm.rgbd_frame_t
+///   ROMO_VEHICLE_STATE      romo_lcm.vehicle_state_t
+///   ROMO_GNSS               romo_lcm.gnss_fix_t
+/// Other channels (ground truth, outputs) pass through untouched as raw events.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "romo/drivers/calibration.hpp"
+#include "romo/drivers/frame_source.hpp"
+#include "romo/drivers/frames.hpp"
+
+namespace romo::drivers {
+
+enum class ImageEncoding : std::uint8_t { kRaw = 0, kPng = 1 };
+
+/// One raw log event.
+struct LogEvent {
+  std::int64_t timestamp_us = 0;  ///< the log's event time (LCM convention: microseconds)
+  std::string channel;
+  std::vector<std::uint8_t> data;
+};
+
+/// Writes a recording. The file is written as "<path>.partial" and renamed to <path> by Close()
+/// (or the destructor), so a file being written is never mistaken for a complete one; every
+/// completed event is flushed so a crash loses at most the event being written.
+class LogWriter {
+ public:
+  /// @throws romo::Error when the file cannot be created.
+  explicit LogWriter(const std::string& path, ImageEncoding encoding = ImageEncoding::kRaw);
+  ~LogWriter();
+  LogWriter(const LogWriter&) = delete;
+  LogWriter& operator=(const LogWriter&) = delete;
+
+  void WriteCalibration(const Calibration& calibration, std::int64_t stamp_ns);
+  /// Writes every part of @p frames (stereo per rig, rgbd, vehicle state, GNSS).
+  void Write(const FrameSet& frames);
+  /// Writes an already-encoded LCM message (e.g. ground truth, outputs).
+  void WriteRaw(const std::string& channel, std::int64_t stamp_ns, const void* data,
+                std::size_t size);
+  /// Flushes and renames the file into place. Idempotent.
+  void Close();
+
+  std::uint64_t events_written() const;
+  std::uint64_t bytes_written() const;
+  const std::string& path() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+enum class Pacing { kAsFastAsPossible, kRealTime };
+
+/// Reads a recording as a frame source (log://file.lcmlog?loop=1&pacing=realtime&seek_s=2.5).
+/// A truncated log yields every complete event, then reports where it was cut in status().
+class LogReader : public FrameSource {
+ public:
+  struct Options {
+    bool loop = false;
+    Pacing pacing = Pacing::kAsFastAsPossible;
+    double seek_s = 0.0;  ///< start this far after the first event
+  };
+  /// @throws romo::Error when the file is missing or not an LCM log.
+  explicit LogReader(const std::string& path, const Options& options);
+  explicit LogReader(const std::string& path) : LogReader(path, Options{}) {}
+  ~LogReader() override;
+
+  std::optional<FrameSet> Next() override;
+  const Calibration* calibration() const override;
+  SourceStatus status() const override;
+
+  /// Jumps to the first frame set at or after @p offset_s from the start of the log.
+  void Seek(double offset_s);
+  /// Raw events of channels that are not frame parts (ground truth, outputs) read while
+  /// assembling the frame set returned by the last Next(); cleared by each Next().
+  const std::vector<LogEvent>& other_events() const;
+  /// True when the file ended inside an event; truncation_offset() says where.
+  bool truncated() const;
+  std::int64_t truncation_offset() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Reads every complete event of a log (for `romo info`, tests); stops at a truncated tail.
+/// @param truncated_at set to the byte offset of the cut, or -1 when the file is complete.
+std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* truncated_at);
+
+}  // namespace romo::drivers
