@@ -1,0 +1,59 @@
+#pragma once
+/// Oriented boxes around blobs (dissertation Fig. 3.9): a PCA box with all three axes free, and a
+/// vertical cuboid whose height axis is the ground normal (only yaw free) for pedestrians and cars.
+///
+/// Heading convention (stable frame to frame): length >= width, and without a hint the yaw lies
+/// in [-pi/2, pi/2) — a box looks the same turned by 180 deg, so the half-open range picks one of
+/// the two. With a hint (a tracker's previous yaw) the equivalent heading nearest the hint is
+/// returned instead, so a track keeps its direction and a near-square box does not jump by 90 deg.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace romo::objects {
+
+struct Box3 {
+  /// Box centre (middle of the extents, not the point mean), metres, in the cloud's frame.
+  Eigen::Vector3f center = Eigen::Vector3f::Zero();
+  /// Extents along axes.col(0), col(1), col(2): length, width, height in metres.
+  Eigen::Vector3f size = Eigen::Vector3f::Zero();
+  /// Heading of axes.col(0) about the up axis, radians, counter-clockwise from the frame's x axis
+  /// (for a PCA box: of col(0) projected onto the xy plane).
+  float yaw_rad = 0.f;
+  /// Columns: unit length, width and height directions (right-handed rotation matrix).
+  Eigen::Matrix3f axes = Eigen::Matrix3f::Identity();
+
+  /// Volume in cubic metres.
+  float volume_m3() const { return size.prod(); }
+  /// True when @p p (same frame) lies inside the box grown by @p margin_m on every side.
+  bool Contains(const Eigen::Vector3f& p, float margin_m = 0.f) const;
+  /// The 8 corners (columns), metres.
+  Eigen::Matrix<float, 3, 8> Corners() const;
+};
+
+/// Full 3D PCA box of the points @p indices of @p xyz (3 x N, metres): axes are the principal
+/// directions (largest variance first), extents the min/max projections. col(2) is flipped to
+/// point up (+z) and col(0) canonicalised as in the header note.
+/// @throws romo::Error when @p indices is empty, out of range or names a non-finite point.
+Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices);
+
+/// Vertical cuboid: height along @p up (unit ground normal, e.g. from ground removal), footprint
+/// the minimum-area rectangle of the points projected onto the ground plane (rotating calipers
+/// over the convex hull, exact for partly seen L-shaped car outlines where PCA is biased).
+/// yaw_rad is measured about @p up from the frame's x axis projected onto the ground plane.
+/// @param hint_yaw_rad previous heading of the same object (e.g. the track's yaw), optional.
+/// @throws romo::Error when @p indices is empty, out of range, names a non-finite point, or
+///         @p up is not a unit vector.
+Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
+                    const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ(),
+                    std::optional<float> hint_yaw_rad = std::nullopt);
+
+/// Canonical heading for a footprint with extents (@p length_m, @p width_m) along a heading
+/// @p yaw_rad: swaps length/width so length >= width and returns the yaw in [-pi/2, pi/2); with
+/// @p hint_yaw_rad, returns the equivalent heading nearest the hint (within pi/2 of it), keeping
+/// length >= width unless the footprint is nearly square (|l - w| < 10 %), where continuity wins.
+float CanonicalYaw(float yaw_rad, float* length_m, float* width_m,
+                   std::optional<float> hint_yaw_rad = std::nullopt);
+
+}  // namespace romo::objects
