@@ -1,0 +1,57 @@
+#include "romo/planning_iface/lcm_bus.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "romo/core/check.hpp"
+
+namespace romo::planning_iface {
+
+class LcmBus::Impl {
+ public:
+  explicit Impl(const std::string& u) : url(u), lcm(u) {}
+
+  struct Subscription {
+    Handler handler;
+    void Receive(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+      handler(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size,
+              rbuf->recv_utime);
+    }
+  };
+
+  std::string url;
+  lcm::LCM lcm;
+  std::vector<std::unique_ptr<Subscription>> subscriptions;
+};
+
+LcmBus::LcmBus(const std::string& url) : impl_(std::make_unique<Impl>(url)) {
+  if (!impl_->lcm.good()) {
+    Fail("LCM: cannot open provider '" + url +
+         "' (udpm:// needs a multicast route: run inside netns-run; memq:// works anywhere)");
+  }
+}
+
+LcmBus::~LcmBus() = default;
+
+void LcmBus::Publish(const std::string& channel, const std::vector<std::uint8_t>& data) {
+  if (impl_->lcm.publish(channel, data.data(), static_cast<unsigned int>(data.size())) != 0) {
+    Fail("LCM: publishing " + std::to_string(data.size()) + " bytes on " + channel + " via '" +
+         impl_->url + "' failed");
+  }
+}
+
+void LcmBus::Subscribe(const std::string& channel_regex, Handler handler) {
+  auto sub = std::make_unique<Impl::Subscription>();
+  sub->handler = std::move(handler);
+  impl_->lcm.subscribe(channel_regex, &Impl::Subscription::Receive, sub.get());
+  impl_->subscriptions.push_back(std::move(sub));
+}
+
+bool LcmBus::Handle(int timeout_ms) {
+  const int r = impl_->lcm.handleTimeout(timeout_ms);
+  if (r < 0) Fail("LCM: handling messages on '" + impl_->url + "' failed");
+  return r > 0;
+}
+
+const std::string& LcmBus::url() const { return impl_->url; }
+
+}  // namespace romo::planning_iface
