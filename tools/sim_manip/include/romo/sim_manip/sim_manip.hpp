@@ -1,0 +1,71 @@
+#pragma once
+/// A simulated manipulation scene for the indoor plugin: an interaction plane (table or
+/// whiteboard), a couple of objects and a hand-sized blob moving like a person doing an action,
+/// rendered as registered RGB-D with Kinect-like depth noise and holes. Seeded and deterministic.
+///
+/// URI: sim-manip://ACTION?seed=N[&frames=F][&width=W][&height=H][&fps=R][&noise=0|1]
+/// ACTION is one of romo::indoor_manip::ActionNames(). The camera looks at the hand's start
+/// position, so the hand covers the image centre in frame 0 (truth().seed_px).
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "romo/drivers/calibration.hpp"
+#include "romo/drivers/frames.hpp"
+#include "romo/drivers/uri.hpp"
+
+namespace romo::sim_manip {
+
+struct SimManipOptions {
+  std::string action;
+  std::uint64_t seed = 0;
+  int frames = 210;
+  int width_px = 320;
+  int height_px = 240;
+  double fps = 30.0;
+  bool noise = true;  ///< depth noise, holes and colour noise
+
+  /// Reads the URI's path (action) and query; @throws romo::Error naming the key and value.
+  static SimManipOptions FromUri(const drivers::Uri& uri);
+  void Validate() const;
+};
+
+struct SimManipTruth {
+  /// Plane (a, b, c, d) in the camera frame, |n| = 1, camera on the positive side.
+  Eigen::Vector4d plane_camera = Eigen::Vector4d::Zero();
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  std::vector<Eigen::Vector3d> hand_centre_camera_m;  ///< per frame
+  std::vector<double> hand_yaw_rad;  ///< rotation about the plane normal per frame
+  int seed_u_px = 0;
+  int seed_v_px = 0;
+  /// Three pixels on the free plane (for --plane u1,v1,u2,v2,u3,v3).
+  std::vector<std::pair<int, int>> plane_pixels;
+};
+
+class SimManipScene {
+ public:
+  /// @throws romo::Error for an unknown action or invalid options.
+  explicit SimManipScene(const SimManipOptions& options);
+  ~SimManipScene();
+  SimManipScene(const SimManipScene&) = delete;
+  SimManipScene& operator=(const SimManipScene&) = delete;
+
+  int frame_count() const;
+  /// Frame @p k (0-based): rgb8 and mono16 depth (1 mm units), stamp k / fps.
+  drivers::RgbdFrame Render(int k) const;
+  const SimManipTruth& truth() const;
+  /// One rig (id 0, "sim_manip") whose left intrinsics are the depth camera's.
+  const drivers::Calibration& calibration() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Registers the "sim-manip" source scheme (idempotent).
+void RegisterSimManipScheme();
+
+}  // namespace romo::sim_manip

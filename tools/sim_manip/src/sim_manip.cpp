@@ -1,0 +1,325 @@
+#include "romo/sim_manip/sim_manip.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "romo/core/check.hpp"
+#include "romo/drivers/frame_source.hpp"
+#include "romo/indoor_manip/action_label.hpp"
+#include "trajectories.hpp"
+
+namespace romo::sim_manip {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Hand-sized ellipsoid: semi-axes along the hand's x (fingers), y, z (plane normal), metres.
+const Eigen::Vector3d kHandSemiAxes(0.045, 0.035, 0.025);
+
+// Deterministic lattice noise in [0, 1): textures that optical flow can follow.
+double Hash(std::int64_t x, std::int64_t y, std::uint64_t salt) {
+  std::uint64_t h = static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^
+                    static_cast<std::uint64_t>(y) * 0xC2B2AE3D27D4EB4Full ^ salt;
+  h ^= h >> 31;
+  h *= 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 27;
+  return (h >> 11) * (1.0 / 9007199254740992.0);
+}
+double ValueNoise(double x, double y, double cell, std::uint64_t salt) {
+  const double fx = x / cell, fy = y / cell;
+  const auto ix = static_cast<std::int64_t>(std::floor(fx));
+  const auto iy = static_cast<std::int64_t>(std::floor(fy));
+  const double tx = fx - ix, ty = fy - iy;
+  const double sx = tx * tx * (3 - 2 * tx), sy = ty * ty * (3 - 2 * ty);
+  const double a = Hash(ix, iy, salt), b = Hash(ix + 1, iy, salt);
+  const double c = Hash(ix, iy + 1, salt), d = Hash(ix + 1, iy + 1, salt);
+  return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
+}
+
+// Axial noise of a Kinect v1 (Nguyen, Izadi, Lovell 2012): 1.2 mm + 1.9 mm * (z - 0.4 m)^2.
+double KinectSigmaM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
+
+struct Box {
+  Eigen::Vector3d lo, hi;  // plane frame
+  Eigen::Vector3d rgb;
+};
+
+}  // namespace
+
+SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
+  SimManipOptions o;
+  o.action = uri.path;
+  for (const auto& [key, value] : uri.query) {
+    if (key != "seed" && key != "frames" && key != "width" && key != "height" && key != "fps" &&
+        key != "noise") {
+      Fail("sim-manip URI '" + uri.ToString() + "': unknown query key '" + key +
+           "' (known: seed, frames, width, height, fps, noise)");
+    }
+  }
+  if (auto v = uri.GetInt("seed")) {
+    if (*v < 0) Fail("sim-manip URI: seed must be >= 0, got " + std::to_string(*v));
+    o.seed = static_cast<std::uint64_t>(*v);
+  }
+  if (auto v = uri.GetInt("frames")) o.frames = static_cast<int>(*v);
+  if (auto v = uri.GetInt("width")) o.width_px = static_cast<int>(*v);
+  if (auto v = uri.GetInt("height")) o.height_px = static_cast<int>(*v);
+  if (auto v = uri.GetDouble("fps")) o.fps = *v;
+  if (auto v = uri.GetInt("noise")) o.noise = *v != 0;
+  o.Validate();
+  return o;
+}
+
+void SimManipOptions::Validate() const {
+  const auto& names = indoor_manip::ActionNames();
+  if (std::find(names.begin(), names.end(), action) == names.end()) {
+    indoor_manip::ActionPartner(action);  // throws, listing the known actions
+  }
+  if (frames < 2 || frames > 100000) Fail("sim-manip: frames must be in [2, 100000], got " + std::to_string(frames));
+  if (width_px < 64 || height_px < 48 || width_px > 4096 || height_px > 4096) {
+    Fail("sim-manip: image size must be within 64x48 .. 4096x4096, got " + std::to_string(width_px) +
+         "x" + std::to_string(height_px));
+  }
+  if (!(fps >= 1.0 && fps <= 240.0)) Fail("sim-manip: fps must be in [1, 240], got " + std::to_string(fps));
+}
+
+class SimManipScene::Impl {
+ public:
+  explicit Impl(const SimManipOptions& o) : opt_(o) {
+    o.Validate();
+    const std::uint64_t action_salt = std::hash<std::string>{}(o.action);
+    salt_ = o.seed * 0x100000001B3ull ^ action_salt;
+    std::mt19937_64 rng(salt_);
+    path_ = internal::GenerateHandPath(o.action, rng, o.frames, o.fps);
+    board_ = internal::IsBoardAction(o.action);
+
+    // Kinect v1 intrinsics scaled to the image size.
+    const double s = o.width_px / 640.0;
+    K_ << 525.0 * s, 0, (o.width_px - 1) / 2.0, 0, 525.0 * s, (o.height_px - 1) / 2.0, 0, 0, 1;
+
+    // Camera looking at the hand's start: from the front for a board, from above-front
+    // (50 deg elevation) for a table. Plane frame P: x along the plane, z its normal.
+    const Eigen::Vector3d target(0.0, 0.0, path_.front().h_m);
+    Eigen::Vector3d eye;
+    Eigen::Vector3d up_hint;
+    if (board_) {
+      eye = target + Eigen::Vector3d(0.05, -0.1, 1.3);
+      up_hint = Eigen::Vector3d::UnitY();
+    } else {
+      const double el = 50.0 * M_PI / 180.0, dist = 1.0;
+      eye = target + dist * Eigen::Vector3d(0.0, -std::cos(el), std::sin(el));
+      up_hint = Eigen::Vector3d::UnitZ();
+    }
+    const Eigen::Vector3d zc = (target - eye).normalized();  // optical axis
+    const Eigen::Vector3d xc = zc.cross(up_hint).normalized();  // image right
+    const Eigen::Vector3d yc = zc.cross(xc);  // image down
+    R_P_C_.col(0) = xc;
+    R_P_C_.col(1) = yc;
+    R_P_C_.col(2) = zc;
+    eye_ = eye;
+
+    // Objects on the plane, away from the hand's working area.
+    if (board_) {
+      boxes_.push_back({{-0.35, -0.55, 0.0}, {0.6, -0.5, 0.06}, {0.55, 0.55, 0.6}});  // marker tray
+      boxes_.push_back({{-0.3, 0.15, 0.0}, {-0.22, 0.23, 0.02}, {0.8, 0.2, 0.2}});   // magnet
+    } else {
+      boxes_.push_back({{-0.32, 0.12, 0.0}, {-0.24, 0.2, 0.12}, {0.2, 0.35, 0.8}});  // cup
+      boxes_.push_back({{0.22, -0.2, 0.0}, {0.37, -0.1, 0.04}, {0.3, 0.7, 0.3}});   // box
+    }
+
+    // Truth in the camera frame.
+    const Eigen::Matrix3d R_C_P = R_P_C_.transpose();
+    const Eigen::Vector3d n_C = R_C_P * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d origin_C = R_C_P * (Eigen::Vector3d::Zero() - eye_);
+    truth_.plane_camera << n_C, -n_C.dot(origin_C);
+    if (truth_.plane_camera[3] < 0) truth_.plane_camera = -truth_.plane_camera;
+    truth_.K = K_;
+    for (const auto& p : path_) {
+      truth_.hand_centre_camera_m.push_back(R_C_P * (Eigen::Vector3d(p.u_m, p.v_m, p.h_m) - eye_));
+      truth_.hand_yaw_rad.push_back(p.yaw_rad);
+    }
+    const Eigen::Vector3d c0 = truth_.hand_centre_camera_m.front();
+    truth_.seed_u_px = static_cast<int>(std::lround(K_(0, 0) * c0.x() / c0.z() + K_(0, 2)));
+    truth_.seed_v_px = static_cast<int>(std::lround(K_(1, 1) * c0.y() / c0.z() + K_(1, 2)));
+    // Three free plane pixels spread over the image's lower half / corners.
+    const int w = o.width_px, h = o.height_px;
+    truth_.plane_pixels = board_ ? std::vector<std::pair<int, int>>{{w / 10, h / 10}, {w - w / 10, h / 8}, {w / 8, h - h / 5}}
+                                 : std::vector<std::pair<int, int>>{{w / 10, h - h / 10}, {w - w / 10, h - h / 12}, {w / 2, h / 12}};
+
+    drivers::RigCalibration rig;
+    rig.rig_id = 0;
+    rig.name = "sim_manip";
+    rig.width_px = w;
+    rig.height_px = h;
+    rig.left.K = K_;
+    rig.right.K = K_;
+    calibration_.rigs.push_back(rig);
+  }
+
+  drivers::RgbdFrame Render(int k) const {
+    ROMO_THROW_UNLESS(k >= 0 && k < opt_.frames);
+    const int w = opt_.width_px, h = opt_.height_px;
+    const internal::HandPose& hp = path_[k];
+    const Eigen::Vector3d hand_c(hp.u_m, hp.v_m, hp.h_m);
+    const Eigen::Matrix3d R_P_H =
+        (Eigen::AngleAxisd(hp.yaw_rad, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(hp.pitch_rad, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(hp.roll_rad, Eigen::Vector3d::UnitY()))
+            .toRotationMatrix();
+    const Eigen::Vector3d light = Eigen::Vector3d(0.3, -0.4, 1.0).normalized();
+    std::vector<double> depth(static_cast<std::size_t>(w) * h, 0.0);
+    std::vector<Eigen::Vector3d> colour(depth.size(), Eigen::Vector3d::Zero());
+    const double fx = K_(0, 0), fy = K_(1, 1), cx = K_(0, 2), cy = K_(1, 2);
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        // Direction with camera-frame z = 1: the ray parameter is the depth itself.
+        const Eigen::Vector3d d = R_P_C_ * Eigen::Vector3d((u - cx) / fx, (v - cy) / fy, 1.0);
+        double best = kInf;
+        Eigen::Vector3d rgb(0, 0, 0);
+        // Plane z = 0.
+        if (d.z() < -1e-9) {
+          const double t = -eye_.z() / d.z();
+          const Eigen::Vector3d p = eye_ + t * d;
+          best = t;
+          const double tex = ValueNoise(p.x(), p.y(), 0.02, 11) * 0.6 + ValueNoise(p.x(), p.y(), 0.005, 12) * 0.4;
+          rgb = board_ ? Eigen::Vector3d(0.86, 0.87, 0.88) * (0.9 + 0.1 * tex)
+                       : Eigen::Vector3d(0.62, 0.45, 0.3) * (0.7 + 0.3 * tex);
+        }
+        for (const Box& b : boxes_) {
+          double t0 = 0.0, t1 = kInf;
+          int axis = -1;
+          bool hit = true;
+          for (int a = 0; a < 3 && hit; ++a) {
+            if (std::abs(d[a]) < 1e-12) {
+              hit = eye_[a] >= b.lo[a] && eye_[a] <= b.hi[a];
+              continue;
+            }
+            double ta = (b.lo[a] - eye_[a]) / d[a], tb = (b.hi[a] - eye_[a]) / d[a];
+            if (ta > tb) std::swap(ta, tb);
+            if (ta > t0) {
+              t0 = ta;
+              axis = a;
+            }
+            t1 = std::min(t1, tb);
+            hit = t0 <= t1;
+          }
+          if (hit && axis >= 0 && t0 < best) {
+            best = t0;
+            const double shade = axis == 2 ? 1.0 : 0.75;
+            const Eigen::Vector3d p = eye_ + t0 * d;
+            rgb = b.rgb * shade * (0.85 + 0.15 * ValueNoise(p.x() + p.z(), p.y() - p.z(), 0.01, 13));
+          }
+        }
+        // Hand ellipsoid: unit sphere in scaled hand coordinates.
+        const Eigen::Vector3d o = (R_P_H.transpose() * (eye_ - hand_c)).cwiseQuotient(kHandSemiAxes);
+        const Eigen::Vector3d dd = (R_P_H.transpose() * d).cwiseQuotient(kHandSemiAxes);
+        const double A = dd.squaredNorm(), B = 2 * o.dot(dd), C = o.squaredNorm() - 1.0;
+        const double disc = B * B - 4 * A * C;
+        if (disc > 0) {
+          const double t = (-B - std::sqrt(disc)) / (2 * A);
+          if (t > 0 && t < best) {
+            best = t;
+            const Eigen::Vector3d ls = o + t * dd;  // unit sphere point
+            const Eigen::Vector3d lp = ls.cwiseProduct(kHandSemiAxes);
+            const Eigen::Vector3d n_P = R_P_H * ls.cwiseQuotient(kHandSemiAxes).normalized();
+            const double lambert = 0.55 + 0.45 * std::max(0.0, n_P.dot(light));
+            // Texture fixed to the hand (skin folds, nails, the tool): flow follows rotations.
+            const double tex = 0.55 * ValueNoise(lp.x() + lp.z(), lp.y() - lp.z(), 0.012, 21) +
+                               0.45 * ValueNoise(lp.x() - lp.z(), lp.y() + 0.5 * lp.z(), 0.006, 22);
+            rgb = Eigen::Vector3d(0.85, 0.62, 0.5) * lambert * (0.55 + 0.45 * tex);
+          }
+        }
+        if (best < kInf && best < 6.0) {
+          depth[static_cast<std::size_t>(v) * w + u] = best;
+          colour[static_cast<std::size_t>(v) * w + u] = rgb;
+        }
+      }
+    }
+
+    drivers::RgbdFrame frame;
+    frame.rgb = drivers::Image::Allocate(drivers::PixelFormat::kRgb8, w, h);
+    frame.depth = drivers::Image::Allocate(drivers::PixelFormat::kMono16, w, h);
+    frame.depth_scale_m = 0.001;
+    frame.stamp_ns = static_cast<std::int64_t>(std::llround(k * 1e9 / opt_.fps));
+    frame.sequence = static_cast<std::uint64_t>(k);
+    std::mt19937_64 rng(salt_ ^ (0xD1B54A32D192ED03ull * (k + 1)));
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    for (int v = 0; v < h; ++v) {
+      auto* drow = reinterpret_cast<std::uint16_t*>(frame.depth.row(v));
+      std::uint8_t* crow = frame.rgb.row(v);
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        double z = depth[i];
+        if (z > 0 && opt_.noise) {
+          // Holes: random dropouts, and the IR shadow right of a near-to-far depth edge.
+          const bool shadow = u >= 1 && depth[i - 1] > 0 && depth[i - 1] < z - 0.05;
+          const bool shadow2 = u >= 2 && depth[i - 2] > 0 && depth[i - 2] < z - 0.05;
+          if (uni(rng) < 0.01 || (shadow && uni(rng) < 0.8) || (shadow2 && uni(rng) < 0.4)) z = 0;
+          else z += KinectSigmaM(z) * gauss(rng);
+        }
+        drow[u] = z > 0 ? static_cast<std::uint16_t>(std::clamp(std::lround(z * 1000.0), 0L, 65535L)) : 0;
+        for (int c = 0; c < 3; ++c) {
+          double val = colour[i][c] * 255.0 + (opt_.noise ? 2.0 * gauss(rng) : 0.0);
+          crow[3 * u + c] = static_cast<std::uint8_t>(std::clamp(std::lround(val), 0L, 255L));
+        }
+      }
+    }
+    return frame;
+  }
+
+  SimManipOptions opt_;
+  std::uint64_t salt_ = 0;
+  bool board_ = false;
+  std::vector<internal::HandPose> path_;
+  Eigen::Matrix3d K_;
+  Eigen::Matrix3d R_P_C_;
+  Eigen::Vector3d eye_;
+  std::vector<Box> boxes_;
+  SimManipTruth truth_;
+  drivers::Calibration calibration_;
+};
+
+SimManipScene::SimManipScene(const SimManipOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+SimManipScene::~SimManipScene() = default;
+int SimManipScene::frame_count() const { return impl_->opt_.frames; }
+drivers::RgbdFrame SimManipScene::Render(int k) const { return impl_->Render(k); }
+const SimManipTruth& SimManipScene::truth() const { return impl_->truth_; }
+const drivers::Calibration& SimManipScene::calibration() const { return impl_->calibration_; }
+
+namespace {
+
+class SimManipSource : public drivers::FrameSource {
+ public:
+  explicit SimManipSource(const SimManipOptions& o) : scene_(o) {}
+  std::optional<drivers::FrameSet> Next() override {
+    if (next_ >= scene_.frame_count()) return std::nullopt;
+    drivers::FrameSet set;
+    set.rgbd = scene_.Render(next_);
+    set.stamp_ns = set.rgbd->stamp_ns;
+    set.sequence = set.rgbd->sequence;
+    ++next_;
+    return set;
+  }
+  const drivers::Calibration* calibration() const override { return &scene_.calibration(); }
+
+ private:
+  SimManipScene scene_;
+  int next_ = 0;
+};
+
+}  // namespace
+
+void RegisterSimManipScheme() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    drivers::RegisterSourceScheme("sim-manip", [](const drivers::Uri& uri) {
+      return std::make_unique<SimManipSource>(SimManipOptions::FromUri(uri));
+    });
+  });
+}
+
+}  // namespace romo::sim_manip
