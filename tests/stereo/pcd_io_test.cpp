@@ -1,0 +1,131 @@
+#include "romo/stereo/pcd_io.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "romo/core/check.hpp"
+#include "test_support.hpp"
+
+namespace romo::stereo {
+namespace {
+
+// Binary PCD stores float32 exactly: a round trip must be bit-exact.
+constexpr float kExactM = 0.f;
+
+PointCloud MakeCloud() {
+  PointCloud c;
+  c.PushBack({1.5f, -2.25f, 10.f}, 0.125f, 200.f);
+  c.PushBack({-0.001f, 3.f, 42.5f}, 1.75f, 0.f);
+  c.PushBack({7.f, 8.f, -9.f}, 0.f, 255.f);
+  return c;
+}
+
+TEST(PcdIoTest, RoundTripKeepsEveryChannel) {
+  test::ScratchDir dir;
+  const PointCloud in = MakeCloud();
+  SavePcd(in, dir / "c.pcd");
+  PcdLoadStats stats;
+  const PointCloud out = LoadPcd(dir / "c.pcd", &stats);
+  ASSERT_EQ(out.size(), in.size());
+  ASSERT_TRUE(out.IsConsistent());
+  EXPECT_EQ(stats.points_in_file, 3u);
+  EXPECT_EQ(stats.dropped_non_finite, 0u);
+  EXPECT_TRUE(stats.had_intensity);
+  EXPECT_TRUE(stats.had_sigma_z);
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    for (int r = 0; r < 3; ++r) EXPECT_NEAR(out.xyz(r, i), in.xyz(r, i), kExactM);
+    EXPECT_EQ(out.sigma_z_m[i], in.sigma_z_m[i]);
+    EXPECT_EQ(out.intensity[i], in.intensity[i]);
+  }
+}
+
+TEST(PcdIoTest, EmptyCloudRoundTrips) {
+  test::ScratchDir dir;
+  SavePcd(PointCloud{}, dir / "e.pcd");
+  EXPECT_TRUE(LoadPcd(dir / "e.pcd").empty());
+}
+
+TEST(PcdIoTest, NonFinitePointsAreDroppedAndCounted) {
+  test::ScratchDir dir;
+  test::WriteFile(dir / "n.pcd",
+                  "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                  "WIDTH 5\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 5\nDATA ascii\n"
+                  "1 2 3\nnan 0 0\n4 5 6\n0 inf 0\n0 0 nan\n");
+  PcdLoadStats stats;
+  const PointCloud c = LoadPcd(dir / "n.pcd", &stats);
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(stats.points_in_file, 5u);
+  EXPECT_EQ(stats.dropped_non_finite, 3u);
+  EXPECT_FALSE(stats.had_intensity);
+  EXPECT_FALSE(stats.had_sigma_z);
+  EXPECT_EQ(c.xyz(2, 1), 6.f);
+  EXPECT_EQ(c.sigma_z_m[0], 0.f);  // absent field reads as "unknown"
+}
+
+TEST(PcdIoTest, ReadsPclTestFiles) {
+  ROMO_REQUIRE_SHARED_DATA("pcl/sac_plane_test.pcd");
+  // ascii with extra normal fields; the file header says 3283 points.
+  const PointCloud plane = LoadPcd(test::SharedData("pcl/sac_plane_test.pcd"));
+  EXPECT_EQ(plane.size(), 3283u);
+  // binary_compressed, x y z only; header says 13704 points.
+  const PointCloud milk = LoadPcd(test::SharedData("pcl/milk.pcd"));
+  EXPECT_EQ(milk.size(), 13704u);
+  // An organised Kinect frame (640x480) where pixels without depth are NaN.
+  PcdLoadStats stats;
+  const PointCloud kinect = LoadPcd(
+      test::SharedData("pcl/grabber_sequences/pcd/frame_20121214T142255.814212.pcd"), &stats);
+  EXPECT_EQ(stats.points_in_file, 640u * 480u);
+  EXPECT_GT(stats.dropped_non_finite, 0u);
+  EXPECT_EQ(kinect.size() + stats.dropped_non_finite, stats.points_in_file);
+  for (Eigen::Index i = 0; i < kinect.xyz.cols(); ++i) ASSERT_TRUE(kinect.xyz.col(i).allFinite());
+}
+
+TEST(PcdIoTest, MissingFileNamesThePath) {
+  try {
+    LoadPcd("/nonexistent/romo/cloud.pcd");
+    FAIL() << "expected romo::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/romo/cloud.pcd"), std::string::npos);
+  }
+}
+
+TEST(PcdIoTest, CorruptFilesNameThePath) {
+  test::ScratchDir dir;
+  test::WriteFile(dir / "garbage.pcd", "this is not a point cloud\n\x01\x02\x03");
+  test::WriteFile(dir / "noxyz.pcd",
+                  "VERSION 0.7\nFIELDS a b\nSIZE 4 4\nTYPE F F\nCOUNT 1 1\nWIDTH 1\nHEIGHT 1\n"
+                  "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2\n");
+  // A valid binary file cut short in its data section (PCL pads binary files, so cut relative
+  // to the header end: 3 points x 20 bytes follow it).
+  SavePcd(MakeCloud(), dir / "full.pcd");
+  const std::string full = test::ReadFile(dir / "full.pcd");
+  const std::size_t data_start = full.find("DATA binary\n");
+  ASSERT_NE(data_start, std::string::npos);
+  test::WriteFile(dir / "cut.pcd", full.substr(0, data_start + 12 + 30));
+  std::vector<std::string> names = {"garbage.pcd", "noxyz.pcd", "cut.pcd"};
+  if (test::HaveSharedData("pcl/milk.pcd")) {
+    // binary_compressed cut short.
+    const std::string milk = test::ReadFile(test::SharedData("pcl/milk.pcd"));
+    test::WriteFile(dir / "milkcut.pcd", milk.substr(0, milk.size() / 2));
+    names.push_back("milkcut.pcd");
+  }
+  for (const std::string& name : names) {
+    try {
+      LoadPcd(dir / name);
+      ADD_FAILURE() << name << ": expected romo::Error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(PcdIoTest, SaveIntoMissingFolderFailsWithPath) {
+  EXPECT_THROW(SavePcd(MakeCloud(), "/nonexistent/romo/out.pcd"), Error);
+}
+
+}  // namespace
+}  // namespace romo::stereo
