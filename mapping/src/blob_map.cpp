@@ -1,0 +1,262 @@
+#include "romo/mapping/blob_map.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "romo/core/check.hpp"
+
+namespace romo::mapping {
+
+Aabb Aabb::Of(const Eigen::Matrix3Xd& xyz, double margin_m) {
+  Aabb b;
+  for (Eigen::Index i = 0; i < xyz.cols(); ++i) {
+    b.lo = b.lo.cwiseMin(xyz.col(i));
+    b.hi = b.hi.cwiseMax(xyz.col(i));
+  }
+  b.lo.array() -= margin_m;
+  b.hi.array() += margin_m;
+  return b;
+}
+
+std::vector<std::pair<int, int>> IntersectBlobs(const std::vector<Aabb>& stored,
+                                                const std::vector<Aabb>& fresh) {
+  std::vector<std::pair<int, int>> out;
+  for (int j = 0; j < static_cast<int>(stored.size()); ++j) {
+    for (int i = 0; i < static_cast<int>(fresh.size()); ++i) {
+      if (stored[j].Intersects(fresh[i])) out.emplace_back(j, i);
+    }
+  }
+  return out;
+}
+
+void PinholeCamera::Validate() const {
+  if (!(fx_px > 0 && fy_px > 0) || width_px <= 0 || height_px <= 0) {
+    Fail("blob map camera: fx, fy, width, height must be positive, got fx=" + std::to_string(fx_px) +
+         " fy=" + std::to_string(fy_px) + " size " + std::to_string(width_px) + "x" +
+         std::to_string(height_px));
+  }
+}
+
+std::vector<int> Blob::ConfidentPoints(const ConfidenceParams& params, double min_cv) const {
+  std::vector<int> out;
+  for (std::size_t i = 0; i < evidence.size(); ++i) {
+    if (ConfidenceValue(evidence[i], params) >= min_cv) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+void BlobMapParams::Validate() const {
+  if (!(chi2_gate > 0)) Fail("blob_map.chi2_gate must be > 0, got " + std::to_string(chi2_gate));
+  if (search_radius_px < 0) Fail("blob_map.search_radius_px must be >= 0, got " + std::to_string(search_radius_px));
+  if (!(occlusion_margin_m > 0)) Fail("blob_map.occlusion_margin_m must be > 0, got " + std::to_string(occlusion_margin_m));
+  confidence.Validate();
+  rigid.Validate();
+}
+
+BlobMap::BlobMap(const BlobMapParams& params) : params_(params) { params_.Validate(); }
+
+namespace {
+
+struct Projection {
+  int u = -1, v = -1;
+  double z = 0;
+};
+
+Projection Project(const PinholeCamera& cam, const Eigen::Isometry3d& T_cam_world,
+                   const Eigen::Vector3d& p_world) {
+  const Eigen::Vector3d p = T_cam_world * p_world;
+  Projection pr;
+  if (!(p.z() > 1e-6)) return pr;
+  const int u = static_cast<int>(std::lround(cam.fx_px * p.x() / p.z() + cam.cx_px));
+  const int v = static_cast<int>(std::lround(cam.fy_px * p.y() / p.z() + cam.cy_px));
+  if (u < 0 || v < 0 || u >= cam.width_px || v >= cam.height_px) return pr;
+  pr.u = u;
+  pr.v = v;
+  pr.z = p.z();
+  return pr;
+}
+
+}  // namespace
+
+BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const PinholeCamera& cam,
+                              const std::vector<float>& depth_m) {
+  cam.Validate();
+  const int w = cam.width_px, h = cam.height_px;
+  if (!depth_m.empty() && depth_m.size() != static_cast<std::size_t>(w) * h) {
+    Fail("blob map: depth image has " + std::to_string(depth_m.size()) + " pixels, camera " +
+         std::to_string(w) + "x" + std::to_string(h));
+  }
+  for (const auto& b : fresh) {
+    if (b.cov_world.size() != static_cast<std::size_t>(b.xyz_world.cols())) {
+      Fail("blob map: observed blob with " + std::to_string(b.xyz_world.cols()) + " points and " +
+           std::to_string(b.cov_world.size()) + " covariances");
+    }
+  }
+  BlobMapUpdate out;
+  const Eigen::Isometry3d T_cam_world = cam.T_world_camera.inverse();
+
+  // Alg. 1 intersection search.
+  std::vector<Aabb> stored_boxes, fresh_boxes;
+  for (const auto& b : blobs_) stored_boxes.push_back(Aabb::Of(b.xyz_world, params_.box_margin_m));
+  for (const auto& b : fresh) fresh_boxes.push_back(Aabb::Of(b.xyz_world, params_.box_margin_m));
+  const auto pairs = IntersectBlobs(stored_boxes, fresh_boxes);
+  out.intersections = static_cast<int>(pairs.size());
+
+  // Current observations bucketed by pixel (eq. 3.6): the nearest observed point per pixel.
+  const std::size_t npx = static_cast<std::size_t>(w) * h;
+  std::vector<std::pair<int, int>> obs_at(npx, {-1, -1});  // (fresh blob, point)
+  std::vector<double> obs_z(npx, std::numeric_limits<double>::infinity());
+  for (int i = 0; i < static_cast<int>(fresh.size()); ++i) {
+    for (Eigen::Index q = 0; q < fresh[i].xyz_world.cols(); ++q) {
+      const Projection pr = Project(cam, T_cam_world, fresh[i].xyz_world.col(q));
+      if (pr.u < 0) continue;
+      const std::size_t px = static_cast<std::size_t>(pr.v) * w + pr.u;
+      if (pr.z < obs_z[px]) {
+        obs_z[px] = pr.z;
+        obs_at[px] = {i, static_cast<int>(q)};
+      }
+    }
+  }
+  // Stored points z-buffered into the current camera (eq. 3.7): only the front-most per pixel
+  // is visible.
+  std::vector<std::pair<int, int>> zbuf(npx, {-1, -1});
+  std::vector<double> zbuf_z(npx, std::numeric_limits<double>::infinity());
+  std::vector<std::vector<Projection>> proj(blobs_.size());
+  for (int j = 0; j < static_cast<int>(blobs_.size()); ++j) {
+    proj[j].resize(blobs_[j].size());
+    for (std::size_t q = 0; q < blobs_[j].size(); ++q) {
+      const Projection pr = Project(cam, T_cam_world, blobs_[j].xyz_world.col(q));
+      proj[j][q] = pr;
+      if (pr.u < 0) continue;
+      const std::size_t px = static_cast<std::size_t>(pr.v) * w + pr.u;
+      if (pr.z < zbuf_z[px]) {
+        zbuf_z[px] = pr.z;
+        zbuf[px] = {j, static_cast<int>(q)};
+      }
+    }
+  }
+
+  std::vector<std::vector<char>> fresh_used(fresh.size());
+  for (std::size_t i = 0; i < fresh.size(); ++i) fresh_used[i].assign(fresh[i].xyz_world.cols(), 0);
+  std::vector<char> fresh_merged(fresh.size(), 0);
+  const int r = params_.search_radius_px;
+
+  for (int j = 0; j < static_cast<int>(blobs_.size()); ++j) {
+    Blob& blob = blobs_[j];
+    std::vector<char> candidate(fresh.size(), 0);
+    bool any = false;
+    for (const auto& [sj, fi] : pairs) {
+      if (sj == j) {
+        candidate[fi] = 1;
+        any = true;
+      }
+    }
+    std::vector<int> matched_stored;
+    std::vector<Eigen::Vector3d> fused_points;
+    std::vector<char> was_matched(blob.size(), 0);
+    for (std::size_t q = 0; q < blob.size(); ++q) {
+      const Projection& pr = proj[j][q];
+      if (pr.u < 0) continue;  // out of view: case 4, unchanged
+      const std::size_t px = static_cast<std::size_t>(pr.v) * w + pr.u;
+      const bool front = zbuf[px].first == j && zbuf[px].second == static_cast<int>(q);
+      // Mahalanobis association in the pixel neighbourhood (eqs. 3.3-3.5).
+      int best_i = -1, best_q = -1;
+      double best = params_.chi2_gate;
+      if (any && front) {
+        const Eigen::Vector3d& pred = blob.xyz_world.col(q);
+        for (int dv = -r; dv <= r; ++dv) {
+          for (int du = -r; du <= r; ++du) {
+            const int u = pr.u + du, v = pr.v + dv;
+            if (u < 0 || v < 0 || u >= w || v >= h) continue;
+            const auto [fi, fq] = obs_at[static_cast<std::size_t>(v) * w + u];
+            if (fi < 0 || !candidate[fi] || fresh_used[fi][fq]) continue;
+            const Eigen::Vector3d nu = fresh[fi].xyz_world.col(fq) - pred;
+            const Eigen::Matrix3d S = blob.cov_world[q] + fresh[fi].cov_world[fq];
+            const double chi2 = nu.dot(S.ldlt().solve(nu));
+            if (chi2 < best) {
+              best = chi2;
+              best_i = fi;
+              best_q = fq;
+            }
+          }
+        }
+      }
+      if (best_i >= 0) {
+        // Kalman fusion (eqs. 3.8-3.10) with H = I.
+        const Eigen::Matrix3d& P = blob.cov_world[q];
+        const Eigen::Matrix3d S = P + fresh[best_i].cov_world[best_q];
+        const Eigen::Matrix3d K = P * S.inverse();
+        const Eigen::Vector3d f = blob.xyz_world.col(q) + K * (fresh[best_i].xyz_world.col(best_q) - blob.xyz_world.col(q));
+        matched_stored.push_back(static_cast<int>(q));
+        fused_points.push_back(f);
+        blob.cov_world[q] = P - K * P;
+        fresh_used[best_i][best_q] = 1;
+        fresh_merged[best_i] = 1;
+        was_matched[q] = 1;
+        UpdateEvidence(Visibility::kMatched, &blob.evidence[q]);
+        ++out.matched;
+        continue;
+      }
+      // Not matched: unobserved prediction if it should have been seen (front-most and nothing
+      // observed clearly in front of it), otherwise occluded (case 4).
+      bool occluded = !front;
+      if (!occluded && !depth_m.empty()) {
+        const float d = depth_m[px];
+        occluded = d > 0.f && d < pr.z - params_.occlusion_margin_m;
+      }
+      if (!occluded) {
+        UpdateEvidence(Visibility::kUnobservedPrediction, &blob.evidence[q]);
+        ++out.unobserved;
+      }
+    }
+    // Rigid check (eq. 3.11): the transform from the stored matched points to the fused ones,
+    // applied to every point of the blob, so occluded parts follow the update.
+    if (matched_stored.size() >= 3) {
+      MatchedPoints3D m;
+      m.p1.resize(3, matched_stored.size());
+      m.p2.resize(3, matched_stored.size());
+      for (std::size_t i = 0; i < matched_stored.size(); ++i) {
+        m.p1.col(i) = blob.xyz_world.col(matched_stored[i]);
+        m.p2.col(i) = fused_points[i];
+        m.cov1.push_back(blob.cov_world[matched_stored[i]]);
+        m.cov2.push_back(blob.cov_world[matched_stored[i]]);
+      }
+      if (const auto rigid = EstimateRigidMotion(m, params_.rigid)) {
+        for (std::size_t q = 0; q < blob.size(); ++q) blob.xyz_world.col(q) = rigid->T_2_1 * blob.xyz_world.col(q).eval();
+        for (int i : rigid->inliers) blob.xyz_world.col(matched_stored[i]) = fused_points[i];
+        out.corrections.emplace_back(blob.id, rigid->T_2_1);
+      }
+    }
+    // Unmatched points of the fresh blobs fused here are unpredicted observations: added.
+    for (std::size_t i = 0; i < fresh.size(); ++i) {
+      if (!candidate[i] || !fresh_merged[i]) continue;
+      for (Eigen::Index q = 0; q < fresh[i].xyz_world.cols(); ++q) {
+        if (fresh_used[i][q]) continue;
+        fresh_used[i][q] = 1;
+        blob.xyz_world.conservativeResize(3, blob.xyz_world.cols() + 1);
+        blob.xyz_world.col(blob.xyz_world.cols() - 1) = fresh[i].xyz_world.col(q);
+        blob.cov_world.push_back(fresh[i].cov_world[q]);
+        PointEvidence e;
+        UpdateEvidence(Visibility::kUnpredictedObservation, &e);
+        blob.evidence.push_back(e);
+        ++out.unpredicted;
+      }
+    }
+  }
+  // Fresh blobs that matched nothing become new stored blobs.
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    if (fresh_merged[i] || fresh[i].xyz_world.cols() == 0) continue;
+    Blob b;
+    b.id = next_id_++;
+    b.xyz_world = fresh[i].xyz_world;
+    b.cov_world = fresh[i].cov_world;
+    b.evidence.assign(b.size(), PointEvidence{1, 0});
+    out.unpredicted += static_cast<int>(b.size());
+    blobs_.push_back(std::move(b));
+    ++out.new_blobs;
+  }
+  return out;
+}
+
+}  // namespace romo::mapping

@@ -1,0 +1,180 @@
+// Blob map on simulated scenes: object completion with confidence values (the trend of Tables
+// 5.2/5.3) and a blob update propagated under partial occlusion.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "romo/core/check.hpp"
+#include "romo/mapping/blob_map.hpp"
+
+namespace romo::mapping {
+namespace {
+
+constexpr double kSigmaM = 0.003;  // 3 mm depth noise, a Kinect at ~1 m
+
+struct BoxScene {
+  Eigen::Vector3d lo{-0.1, -0.05, 0.0};
+  Eigen::Vector3d hi{0.1, 0.05, 0.15};
+};
+
+PinholeCamera Camera(double azimuth_rad) {
+  PinholeCamera c{150, 150, 79.5, 59.5, 160, 120};
+  const Eigen::Vector3d target(0, 0, 0.075);
+  const Eigen::Vector3d eye = target + Eigen::Vector3d(std::cos(azimuth_rad), std::sin(azimuth_rad), 0.6).normalized() * 1.0;
+  const Eigen::Vector3d z = (target - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  c.T_world_camera.linear() << x, y, z;
+  c.T_world_camera.translation() = eye;
+  return c;
+}
+
+// Ray-casts the box; returns the observed blob (world frame) and the frame's depth image.
+ObservedBlob Observe(const BoxScene& box, const Eigen::Vector3d& offset, const PinholeCamera& cam,
+                     std::mt19937_64& rng, std::vector<float>* depth, double keep_x_below = 1e9) {
+  std::normal_distribution<double> n(0.0, kSigmaM);
+  ObservedBlob blob;
+  std::vector<Eigen::Vector3d> pts;
+  depth->assign(static_cast<std::size_t>(cam.width_px) * cam.height_px, 0.f);
+  const Eigen::Vector3d o = cam.T_world_camera.translation();
+  for (int v = 0; v < cam.height_px; ++v) {
+    for (int u = 0; u < cam.width_px; ++u) {
+      const Eigen::Vector3d dc((u - cam.cx_px) / cam.fx_px, (v - cam.cy_px) / cam.fy_px, 1.0);
+      const Eigen::Vector3d d = cam.T_world_camera.linear() * dc;
+      double t0 = 0, t1 = 1e9;
+      bool hit = true;
+      for (int a = 0; a < 3 && hit; ++a) {
+        double ta = (box.lo[a] + offset[a] - o[a]) / d[a], tb = (box.hi[a] + offset[a] - o[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        hit = t0 <= t1;
+      }
+      if (!hit) continue;
+      const double z = t0 + n(rng);  // t is the camera depth: dc has z = 1
+      const Eigen::Vector3d p = o + z * d;
+      // Points beyond keep_x_below are hidden by an occluder 0.3 m in front of the camera.
+      const bool visible = p.x() - offset.x() < keep_x_below;
+      (*depth)[static_cast<std::size_t>(v) * cam.width_px + u] = visible ? static_cast<float>(z) : 0.3f;
+      if (visible) pts.push_back(p);
+    }
+  }
+  blob.xyz_world.resize(3, pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    blob.xyz_world.col(i) = pts[i];
+    const Eigen::Vector3d r = (pts[i] - o).normalized();
+    const double lat = 1.0 / cam.fx_px;  // one pixel at ~1 m
+    blob.cov_world.push_back(lat * lat * Eigen::Matrix3d::Identity() + (kSigmaM * kSigmaM - lat * lat) * r * r.transpose());
+  }
+  return blob;
+}
+
+Eigen::Vector3d Extent(const Blob& b, const std::vector<int>& idx) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (int i : idx) {
+    lo = lo.cwiseMin(b.xyz_world.col(i));
+    hi = hi.cwiseMax(b.xyz_world.col(i));
+  }
+  return hi - lo;
+}
+
+TEST(ConfidenceTest, FourVisibilityCasesAndTheCvFormula) {
+  const ConfidenceParams p;  // alpha 2, beta 1
+  PointEvidence e;
+  UpdateEvidence(Visibility::kUnpredictedObservation, &e);
+  EXPECT_NEAR(ConfidenceValue(e, p), 1 - std::exp(-0.5), 1e-12);
+  UpdateEvidence(Visibility::kMatched, &e);
+  UpdateEvidence(Visibility::kMatched, &e);
+  EXPECT_NEAR(ConfidenceValue(e, p), 1 - std::exp(-1.5), 1e-12);
+  UpdateEvidence(Visibility::kNotExpected, &e);
+  EXPECT_NEAR(ConfidenceValue(e, p), 1 - std::exp(-1.5), 1e-12);
+  UpdateEvidence(Visibility::kUnobservedPrediction, &e);
+  EXPECT_NEAR(ConfidenceValue(e, p), 1 - std::exp(-0.5), 1e-12);
+  UpdateEvidence(Visibility::kUnobservedPrediction, &e);
+  EXPECT_EQ(ConfidenceValue(e, p), 0.0);  // more against than for: no confidence
+  ConfidenceParams bad;
+  bad.alpha = 0;
+  EXPECT_THROW(bad.Validate(), romo::Error);
+}
+
+TEST(BlobMapTest, HighConfidencePointsGiveABoxCloserToTheTruth) {
+  const BoxScene box;
+  BlobMap map{BlobMapParams{}};
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<float> depth;
+  for (int k = 0; k < 8; ++k) {
+    const PinholeCamera cam = Camera(-1.2 + k * 0.3);
+    ObservedBlob blob = Observe(box, Eigen::Vector3d::Zero(), cam, rng, &depth);
+    // Flying pixels at the silhouette: single-frame outliers up to 6 cm off the box.
+    const int n = static_cast<int>(blob.xyz_world.cols());
+    blob.xyz_world.conservativeResize(3, n + 40);
+    for (int i = 0; i < 40; ++i) {
+      const Eigen::Vector3d base = blob.xyz_world.col(std::abs(static_cast<int>(u(rng) * n)) % n);
+      blob.xyz_world.col(n + i) = base + 0.06 * Eigen::Vector3d(u(rng), u(rng), std::abs(u(rng)));
+      blob.cov_world.push_back(blob.cov_world.front());
+    }
+    const auto upd = map.Update({blob}, cam, depth);
+    if (k > 0) EXPECT_GT(upd.matched, 100) << "frame " << k;
+  }
+  ASSERT_EQ(map.blobs().size(), 1u);
+  const Blob& b = map.blobs().front();
+  std::vector<int> all(b.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  const auto confident = b.ConfidentPoints(map.params().confidence, 0.6);
+  ASSERT_GT(confident.size(), 500u);
+  const Eigen::Vector3d truth = box.hi - box.lo;
+  const double err_all = (Extent(b, all) - truth).norm();
+  const double err_conf = (Extent(b, confident) - truth).norm();
+  std::printf("box size error: all %zu points %.4f m, CV >= 0.6 (%zu points) %.4f m\n", b.size(),
+              err_all, confident.size(), err_conf);
+  EXPECT_LT(err_conf, err_all);
+  constexpr double kMaxConfidentErrM = 0.02;  // a few noise sigmas per side
+  EXPECT_LT(err_conf, kMaxConfidentErrM);
+}
+
+TEST(BlobMapTest, PartialOcclusionPropagatesTheUpdateToHiddenPoints) {
+  const BoxScene box;
+  BlobMap map{BlobMapParams{}};
+  std::mt19937_64 rng(9);
+  std::vector<float> depth;
+  const PinholeCamera cam = Camera(-0.4);
+  map.Update({Observe(box, Eigen::Vector3d::Zero(), cam, rng, &depth)}, cam, depth);
+  const Blob before = map.blobs().front();
+  // The box moves 8 mm along x; only its x < 0 half is seen, an occluder hides the rest.
+  const Eigen::Vector3d shift(0.008, 0, 0);
+  ObservedBlob half = Observe(box, shift, cam, rng, &depth, 0.0);
+  const auto upd = map.Update({half}, cam, depth);
+  ASSERT_EQ(upd.corrections.size(), 1u);
+  const Blob& after = map.blobs().front();
+  Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+  int hidden = 0;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (before.xyz_world(0, i) < 0.03) continue;  // clearly in the hidden half
+    moved += after.xyz_world.col(i) - before.xyz_world.col(i);
+    EXPECT_EQ(after.evidence[i].unsupported, 0) << "an occluded point is not evidence against it";
+    ++hidden;
+  }
+  ASSERT_GT(hidden, 50);
+  moved /= hidden;
+  // Equal covariances fuse half way (K = 1/2): hidden points follow by ~4 mm.
+  constexpr double kExpectedM = 0.004, kTolM = 0.002;
+  EXPECT_NEAR(moved.x(), kExpectedM, kTolM);
+  EXPECT_NEAR(moved.y(), 0.0, kTolM);
+  EXPECT_NEAR(moved.z(), 0.0, kTolM);
+}
+
+TEST(BlobMapTest, IntersectionSearchPairsCollidingBoxesOnly) {
+  Eigen::Matrix3Xd a(3, 2), b(3, 2), c(3, 2);
+  a << 0, 1, 0, 1, 0, 1;
+  b << 0.9, 2, 0.9, 2, 0.9, 2;
+  c << 5, 6, 5, 6, 5, 6;
+  const auto pairs = IntersectBlobs({Aabb::Of(a, 0)}, {Aabb::Of(b, 0), Aabb::Of(c, 0)});
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0], std::make_pair(0, 0));
+}
+
+}  // namespace
+}  // namespace romo::mapping
