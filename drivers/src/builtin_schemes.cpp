@@ -5,9 +5,11 @@
 
 namespace romo::drivers {
 
+std::unique_ptr<FrameSource> OpenLogSource(const Uri& uri);   // log_reader.cpp
+
 void RegisterBuiltinSchemes(std::map<std::string, SourceFactory>* factories) {
   // Sources add themselves here as they are implemented: (*factories).emplace("log", ...).
-  (void)factories;
+  factories->emplace("log", &OpenLogSource);
 }
 
 }  // namespace romo::drivers

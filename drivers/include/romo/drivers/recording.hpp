@@ -6,6 +6,7 @@
 ///   ROMO_VEHICLE_STATE      romo_lcm.vehicle_state_t
 ///   ROMO_GNSS               romo_lcm.gnss_fix_t
 /// Other channels (ground truth, outputs) pass through untouched as raw events.
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -19,6 +20,21 @@
 namespace romo::drivers {
 
 enum class ImageEncoding : std::uint8_t { kRaw = 0, kPng = 1 };
+
+inline constexpr char kCalibrationChannel[] = "ROMO_CALIBRATION";
+inline constexpr char kStereoChannelPrefix[] = "ROMO_STEREO_RIG";
+inline constexpr char kRgbdChannel[] = "ROMO_RGBD";
+inline constexpr char kVehicleStateChannel[] = "ROMO_VEHICLE_STATE";
+inline constexpr char kGnssChannel[] = "ROMO_GNSS";
+/// "ROMO_STEREO_RIG<rig_id>".
+std::string StereoChannel(int rig_id);
+/// True for the channels that carry frame-set parts (stereo, RGB-D, vehicle state, GNSS).
+bool IsFramePartChannel(const std::string& channel);
+
+/// The LCM type of an encoded message from its 8-byte fingerprint ("romo_lcm.stereo_frame_t"),
+/// or "unknown". romo_lcm sensor types are known; other modules add theirs with RegisterLcmType.
+std::string LcmTypeName(const std::uint8_t* data, std::size_t size);
+void RegisterLcmType(std::int64_t fingerprint, const std::string& type_name);
 
 /// One raw log event.
 struct LogEvent {
@@ -79,7 +95,8 @@ class LogReader : public FrameSource {
   /// Jumps to the first frame set at or after @p offset_s from the start of the log.
   void Seek(double offset_s);
   /// Raw events of channels that are not frame parts (ground truth, outputs) read while
-  /// assembling the frame set returned by the last Next(); cleared by each Next().
+  /// assembling the frame set returned by the last Next(): those written after the set's parts
+  /// and before the next set's come with it. Cleared by each Next().
   const std::vector<LogEvent>& other_events() const;
   /// True when the file ended inside an event; truncation_offset() says where.
   bool truncated() const;
