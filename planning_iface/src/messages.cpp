@@ -30,20 +30,109 @@ void SetWhy(std::string* why, const std::string& text) {
 }
 
 // LCM's generated decoders size their arrays from the counts in the message before checking the
-// buffer, so a corrupt count could ask for gigabytes: check top-level counts against the size.
-std::int32_t PeekInt32(const void* data, std::size_t size, std::size_t offset) {
-  if (offset + 4 > size) return -1;
-  const auto* b = static_cast<const std::uint8_t*>(data) + offset;
-  return static_cast<std::int32_t>((std::uint32_t{b[0]} << 24) | (std::uint32_t{b[1]} << 16) |
-                                   (std::uint32_t{b[2]} << 8) | std::uint32_t{b[3]});
+// buffer, so a corrupt count could ask for gigabytes. Walk the encoding first: every count must
+// fit the bytes that are left.
+class Walker {
+ public:
+  Walker(const void* data, std::size_t size) : b_(static_cast<const std::uint8_t*>(data)), n_(size) {}
+  bool Skip(std::size_t bytes) {
+    if (!ok_ || bytes > n_ - pos_) return ok_ = false;
+    pos_ += bytes;
+    return true;
+  }
+  /// Reads a count; false (and marks the walk failed) when negative or when count * each bytes
+  /// cannot fit the rest of the message.
+  bool Count(std::size_t each, std::int32_t* out, const char* field) {
+    if (!ok_ || 4 > n_ - pos_) return ok_ = false;
+    const std::uint8_t* p = b_ + pos_;
+    const auto v = static_cast<std::int32_t>((std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
+                                             (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]});
+    pos_ += 4;
+    if (v < 0 || static_cast<std::size_t>(v) * each > n_ - pos_) {
+      bad_field_ = field;
+      bad_value_ = v;
+      return ok_ = false;
+    }
+    *out = v;
+    return true;
+  }
+  bool String(const char* field) {
+    std::int32_t len = 0;
+    return Count(1, &len, field) && Skip(static_cast<std::size_t>(len));
+  }
+  bool ok() const { return ok_; }
+  std::string Reason(const char* type) const {
+    if (bad_field_ != nullptr) {
+      return std::string(type) + "." + bad_field_ + " = " + std::to_string(bad_value_) +
+             " does not fit a " + std::to_string(n_) + "-byte message";
+    }
+    return std::string(type) + ": truncated (" + std::to_string(n_) + " bytes)";
+  }
+
+ private:
+  const std::uint8_t* b_;
+  std::size_t n_;
+  std::size_t pos_ = 0;
+  bool ok_ = true;
+  const char* bad_field_ = nullptr;
+  std::int32_t bad_value_ = 0;
+};
+
+bool WalkObstacleList(Walker& w) {
+  std::int32_t n = 0;
+  if (!(w.Skip(8 + 16) && w.Count(4 + 5 + 4 + 8 * 13 + 4, &n, "num_obstacles"))) return false;
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!(w.Skip(4) && w.String("class_name") && w.Skip(4 + 8 * 13 + 4))) return false;
+  }
+  return true;
 }
 
-bool CountFits(const void* data, std::size_t size, std::size_t offset, std::size_t min_bytes_each,
-               const char* field, std::string* why) {
-  const std::int32_t n = PeekInt32(data, size, offset);
-  if (n < 0 || static_cast<std::size_t>(n) * min_bytes_each > size) {
-    SetWhy(why, std::string(field) + " = " + std::to_string(n) + " does not fit a " +
-                    std::to_string(size) + "-byte message");
+bool WalkParkingSlots(Walker& w) {
+  std::int32_t n = 0;
+  if (!(w.Skip(8 + 16 + 1 + 24) && w.Count(150, &n, "num_slots"))) return false;
+  for (std::int32_t i = 0; i < n; ++i) {
+    std::int32_t points = 0;
+    if (!(w.Skip(4 + 1) && w.String("reason") && w.Skip(4 + 4 + 4 + 8 * 12) &&
+          w.Count(16, &points, "num_path_points") && w.Skip(16 * static_cast<std::size_t>(points)) &&
+          w.Skip(8 + 24))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool WalkPerceptionStatus(Walker& w) {
+  std::int32_t n = 0;
+  if (!(w.Skip(8 + 16) && w.Count(29, &n, "num_rigs") && w.Skip(29 * static_cast<std::size_t>(n)) &&
+        w.Count(9, &n, "num_stages"))) {
+    return false;
+  }
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!(w.String("stages.name") && w.Skip(4))) return false;
+  }
+  if (!(w.Skip(4 + 24) && w.Count(5, &n, "num_events"))) return false;
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!w.String("events")) return false;
+  }
+  return true;
+}
+
+bool WalkRigCloud(Walker& w) {
+  std::int32_t points = 0, coords = 0;
+  return w.Skip(8 + 16 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
+         w.Skip(2 * static_cast<std::size_t>(coords)) && w.Skip(3 * static_cast<std::size_t>(points)) &&
+         w.Skip(8);
+}
+
+bool Walk(const void* data, std::size_t size, bool (*walk)(Walker&), const char* type,
+          std::string* why) {
+  if (data == nullptr) {
+    SetWhy(why, std::string(type) + ": no data");
+    return false;
+  }
+  Walker w(data, size);
+  if (!walk(w)) {
+    SetWhy(why, w.Reason(type));
     return false;
   }
   return true;
@@ -147,7 +236,7 @@ std::vector<std::uint8_t> Encode(const ObstacleList& list) {
 
 std::optional<ObstacleList> DecodeObstacleList(const void* data, std::size_t size, std::string* why) {
   romo_lcm::obstacle_list_t msg;
-  if (!CountFits(data, size, 24, 121, "obstacle_list_t.num_obstacles", why) ||
+  if (!Walk(data, size, WalkObstacleList, "obstacle_list_t", why) ||
       !DecodeMessage(data, size, "obstacle_list_t", &msg, why)) {
     return std::nullopt;
   }
@@ -230,7 +319,7 @@ std::vector<std::uint8_t> Encode(const ParkingSlotReport& report) {
 std::optional<ParkingSlotReport> DecodeParkingSlots(const void* data, std::size_t size,
                                                     std::string* why) {
   romo_lcm::parking_slots_t msg;
-  if (!CountFits(data, size, 49, 150, "parking_slots_t.num_slots", why) ||
+  if (!Walk(data, size, WalkParkingSlots, "parking_slots_t", why) ||
       !DecodeMessage(data, size, "parking_slots_t", &msg, why)) {
     return std::nullopt;
   }
@@ -332,7 +421,7 @@ std::vector<std::uint8_t> Encode(const PerceptionStatus& status) {
 std::optional<PerceptionStatus> DecodePerceptionStatus(const void* data, std::size_t size,
                                                        std::string* why) {
   romo_lcm::perception_status_t msg;
-  if (!CountFits(data, size, 24, 29, "perception_status_t.num_rigs", why) ||
+  if (!Walk(data, size, WalkPerceptionStatus, "perception_status_t", why) ||
       !DecodeMessage(data, size, "perception_status_t", &msg, why)) {
     return std::nullopt;
   }
@@ -400,8 +489,7 @@ std::vector<std::uint8_t> Encode(const RigCloud& rc, double scale_m) {
 
 std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::string* why) {
   romo_lcm::rig_cloud_t msg;
-  if (!CountFits(data, size, 32, 3, "rig_cloud_t.num_points", why) ||
-      !CountFits(data, size, 36, 2, "rig_cloud_t.num_coords", why) ||
+  if (!Walk(data, size, WalkRigCloud, "rig_cloud_t", why) ||
       !DecodeMessage(data, size, "rig_cloud_t", &msg, why)) {
     return std::nullopt;
   }

@@ -58,6 +58,12 @@ double HalfExtentAlong(const GroundBox& b, const Eigen::Vector2d& u) {
   return std::abs(a.dot(u)) * b.length_m / 2 + std::abs(Perp(a).dot(u)) * b.width_m / 2;
 }
 
+// Of the two headings along an axis, the one closer to @p reference (ties: @p axis_yaw itself).
+double HeadingAlong(double axis_yaw, double reference) {
+  return WrapAngle(std::abs(WrapAngle(reference - axis_yaw)) > kPi / 2 + 1e-12 ? axis_yaw + kPi
+                                                                             : axis_yaw);
+}
+
 // Difference of two headings modulo 180 degrees, in (-pi/2, pi/2].
 double AxisDiff(double a, double b) {
   double d = WrapAngle(a - b);
@@ -127,7 +133,7 @@ void ParkingParams::Validate() const {
   positive(ego_width_m, "ego_width_m");
   non_negative(end_margin_m, "end_margin_m");
   non_negative(min_clearance_m, "min_clearance_m");
-  non_negative(approach_standoff_m, "approach_standoff_m");
+  non_negative(turn_clearance_m, "turn_clearance_m");
   positive(row_yaw_tolerance_rad, "row_yaw_tolerance_rad");
   positive(row_lateral_tolerance_m, "row_lateral_tolerance_m");
   non_negative(min_gap_m, "min_gap_m");
@@ -177,8 +183,10 @@ void EvaluateSlot(const std::vector<GroundBox>& cars, const Pose2& ego, const Pa
   const double ego_across = HalfExtentAlong(ego_box, n) * 2;
 
   slot->approach.yaw_rad = slot->target.yaw_rad;
+  const double half_diagonal = 0.5 * std::hypot(params.ego_length_m, params.ego_width_m);
+  const double turn_radius = std::max(half_diagonal, ego_across / 2);
   slot->approach.position_m =
-      slot->target.position_m + n * (slot->depth_m / 2 + params.approach_standoff_m + ego_across / 2);
+      slot->target.position_m + n * (slot->depth_m / 2 + turn_radius + params.turn_clearance_m);
   // RoMo drives straight to the spot, so it arrives with its current heading.
   slot->rotation_rad = WrapAngle(slot->target.yaw_rad - ego.yaw_rad);
 
@@ -186,6 +194,14 @@ void EvaluateSlot(const std::vector<GroundBox>& cars, const Pose2& ego, const Pa
   slot->entry_path_m.resize(m);
   double c_prev = std::numeric_limits<double>::infinity();
   double c_next = c_prev, c_other = c_prev;
+  // The turn on the spot sweeps the circle of the half diagonal around the approach spot.
+  for (const auto& car : cars) {
+    if (IsNeighbour(car, *slot)) continue;
+    GroundBox dot;
+    dot.center_m = slot->approach.position_m;
+    dot.length_m = dot.width_m = 1e-6;
+    c_other = std::min(c_other, FootprintDistance(dot, car) - turn_radius);
+  }
   for (int k = 0; k < m; ++k) {
     const double t = static_cast<double>(k) / (m - 1);
     slot->entry_path_m[k] = (1 - t) * slot->approach.position_m + t * slot->target.position_m;
@@ -288,13 +304,17 @@ std::vector<ParkingSlot> FindParkingSlots(const std::vector<GroundBox>& cars, co
       ParkingSlot slot;
       slot.row_axis = gap.u;
       const Eigen::Vector2d n = Perp(gap.u);
-      const double t_mid = 0.5 * (a.center_m + b.center_m).dot(n);
-      slot.target.position_m = gap.u * (0.5 * (gap.start + gap.end)) + n * t_mid;
+      // Across the row the slot spans both neighbours from their front to their back.
+      const double lo = std::min(a.center_m.dot(n) - HalfExtentAlong(a, n),
+                                 b.center_m.dot(n) - HalfExtentAlong(b, n));
+      const double hi = std::max(a.center_m.dot(n) + HalfExtentAlong(a, n),
+                                 b.center_m.dot(n) + HalfExtentAlong(b, n));
+      slot.target.position_m = gap.u * (0.5 * (gap.start + gap.end)) + n * (0.5 * (lo + hi));
       slot.length_m = gap.end - gap.start;
-      slot.depth_m = HalfExtentAlong(a, n) + HalfExtentAlong(b, n);
-      const double car_yaw = a.yaw_rad + 0.5 * AxisDiff(b.yaw_rad, a.yaw_rad);
-      // Of the two headings parallel to the neighbours, the one needing the smaller turn.
-      slot.target.yaw_rad = WrapAngle(car_yaw + AxisDiff(ego.yaw_rad, car_yaw));
+      slot.depth_m = hi - lo;
+      // Of the two headings along the row, the one needing the smaller turn.
+      const double row_yaw = std::atan2(gap.u.y(), gap.u.x());
+      slot.target.yaw_rad = HeadingAlong(row_yaw, ego.yaw_rad);
       slot.aisle_normal = (ego.position_m - slot.target.position_m).dot(n) >= 0 ? n : Eigen::Vector2d(-n);
       slot.prev_id = a.id;
       slot.next_id = b.id;
@@ -369,7 +389,7 @@ std::vector<ParkingSlot> ParkingSlotEstimator::Update(const std::vector<GroundBo
   // Re-plan every slot for the ego's current pose: the aligned heading needing the smaller turn,
   // approach, path and clearances against the cars seen now and the slot's neighbours.
   for (ParkingSlot& s : slots_) {
-    s.target.yaw_rad = WrapAngle(s.target.yaw_rad + AxisDiff(ego.yaw_rad, s.target.yaw_rad));
+    s.target.yaw_rad = HeadingAlong(s.target.yaw_rad, ego.yaw_rad);
     EvaluateSlot(cars, ego, params_, &s);
     s.confidence = (1.0 - std::exp(-s.seen_frames / params_.confidence_frames)) *
                    std::pow(params_.miss_decay, s.missed_frames);

@@ -2,8 +2,10 @@
 /// Parking-slot estimation from the boxes of parked cars (dissertation 4.3.3, ref. [99]).
 /// Pure 2D geometry in the ground plane of one frame (vehicle or world: the caller names it);
 /// no middleware. The maneuver it plans is RoMo's: drive forward to an approach spot centred in
-/// front of the gap, rotate on the spot until parallel to the neighbours, drive sideways (crab)
-/// into the gap.
+/// front of the gap, rotate on the spot until aligned with the row of neighbours (the ego's
+/// length along the row), drive sideways (crab) into the gap. The row runs along the cars for
+/// parallel parking and across them for bays side by side; either way the ego's length lies
+/// along the row, so a gap fits when it is longer than the ego plus both end margins.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -32,11 +34,12 @@ struct ParkingParams {
   double ego_length_m = 2.8;  ///< RoMo
   double ego_width_m = 1.6;
   /// Free space required between the ego and each neighbour once parked, along the row.
-  double end_margin_m = 0.3;
+  double end_margin_m = 0.2;
   /// The ego footprint never comes closer than this to any car along the whole entry path.
-  double min_clearance_m = 0.25;
-  /// Gap between the row's front edge and the ego's side at the approach spot.
-  double approach_standoff_m = 0.8;
+  double min_clearance_m = 0.15;
+  /// Turning on the spot sweeps a circle of the ego's half diagonal: the approach spot keeps
+  /// this much more from the row's front edge and from every car.
+  double turn_clearance_m = 0.3;
   /// Two cars belong to one row when their headings differ by less than this (mod 180 deg)...
   double row_yaw_tolerance_rad = 0.35;
   /// ...and their centres are this close to one line along the row.
@@ -61,9 +64,9 @@ struct ParkingParams {
 /// One free gap between two neighbouring parked cars and the maneuver into it.
 struct ParkingSlot {
   int slot_id = -1;  ///< stable over frames (ParkingSlotEstimator); -1 from FindParkingSlots
-  Pose2 target;      ///< where the ego ends: centred in the gap, parallel to the neighbours
+  Pose2 target;      ///< where the ego ends: centred in the gap, heading along the row
   double length_m = 0.0;  ///< free length along the row between the neighbours
-  double depth_m = 0.0;   ///< extent across the row (the neighbours' depth)
+  double depth_m = 0.0;   ///< extent across the row (front to back of both neighbours)
   Eigen::Vector2d row_axis = Eigen::Vector2d::UnitX();  ///< unit, from prev to next neighbour
   Eigen::Vector2d aisle_normal = Eigen::Vector2d::UnitY();  ///< unit, from the row to the aisle
   int prev_id = -1;
@@ -75,7 +78,7 @@ struct ParkingSlot {
   std::vector<Eigen::Vector2d> entry_path_m;  ///< approach spot -> target, sideways
   double clearance_prev_m = 0.0;  ///< least ego-to-neighbour distance along the entry path
   double clearance_next_m = 0.0;
-  double clearance_other_m = 0.0;  ///< least distance to any other car (approach and path)
+  double clearance_other_m = 0.0;  ///< least distance to any other car (turn circle and path)
   bool feasible = false;
   std::string reason;        ///< why not feasible ("" when feasible)
   double confidence = 0.0;   ///< 0..1, from ParkingSlotEstimator
