@@ -1,0 +1,116 @@
+#pragma once
+/// Multi-object tracking in the ground plane (dissertation 4.3.4, Fig. 4.16): a constant-velocity
+/// Kalman filter per track, Mahalanobis gating, optimal (Hungarian) assignment, a
+/// tentative/confirmed/lost lifecycle, coasting through total occlusion, and merged blobs of two
+/// pedestrians shared by both of their tracks (partial occlusion). Pedestrian tracks carry an
+/// RLS path prediction.
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "romo/objects/atlas.hpp"
+#include "romo/objects/box.hpp"
+#include "romo/objects/path_prediction.hpp"
+
+namespace romo::objects {
+
+/// One blob's box in the tracking frame (ground plane xy, z up), with its Atlas class.
+struct Detection {
+  Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();  ///< footprint centre
+  double yaw_rad = 0.0;                            ///< footprint heading (mod pi)
+  double length_m = 0.0;                           ///< footprint, length >= width
+  double width_m = 0.0;
+  double height_m = 0.0;
+  Classification classification;
+
+  /// From a vertical box (centre xy, size, yaw) classified by @p atlas.
+  static Detection FromBox(const Box3& box, const Atlas& atlas);
+};
+
+enum class TrackState {
+  kTentative,  ///< seen fewer than confirm_hits times
+  kConfirmed,  ///< seen in the last frame
+  kLost,       ///< confirmed, not seen now: coasting on its prediction (total occlusion)
+};
+const char* ToString(TrackState state);
+
+/// A track as reported after each Update().
+struct Track {
+  int id = 0;
+  TrackState state = TrackState::kTentative;
+  int class_index = -1;           ///< Atlas class voted by its detections
+  double class_score = 0.0;       ///< mean score of the winning class's votes
+  Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();   ///< filtered (or coasted) position
+  Eigen::Vector2d velocity_mps = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d position_cov_m2 = Eigen::Matrix2d::Zero();
+  double yaw_rad = 0.0;           ///< box heading, unwrapped against the track (mod pi)
+  double length_m = 0.0, width_m = 0.0, height_m = 0.0;
+  double first_seen_s = 0.0;
+  double last_seen_s = 0.0;       ///< time of the last associated detection
+  int hits = 0;                   ///< associated detections so far
+  bool merged = false;            ///< shares a merged blob with another track this frame
+  int detection_index = -1;       ///< detection associated this frame, or -1
+  /// Last observed position (the RLS trail's newest point) and its time.
+  Eigen::Vector2d observed_xy_m = Eigen::Vector2d::Zero();
+  double observed_s = 0.0;
+  /// Predicted path from the last observation (pedestrian classes; kept through occlusion).
+  std::vector<PredictedPoint> predicted_path;
+};
+
+struct TrackerParams {
+  double measurement_sigma_m = 0.15;   ///< position noise of a single-object detection
+  double accel_sigma_mps2 = 1.5;       ///< white-noise acceleration of the CV model
+  double initial_speed_sigma_mps = 2.0;
+  /// Mahalanobis gate (chi-square, 2 dof): 13.8 = 99.9 %; occluded tracks' grown covariance
+  /// widens their gate by itself.
+  double gate_chi2 = 13.8;
+  int confirm_hits = 3;
+  /// A tentative track dies after this many frames without a detection.
+  int tentative_max_misses = 1;
+  /// Total occlusion: a confirmed track coasts this long without detections (s); a class's
+  /// Atlas max_occlusion_s overrides it when larger.
+  double max_occlusion_s = 2.0;
+  /// Partial occlusion: a blob that is pedestrian-tall but longer than a typical pedestrian
+  /// (Atlas mean + sigma) may be shared by up to this many pedestrian tracks.
+  int max_tracks_per_blob = 2;
+  /// Tracks sharing a blob are held inside it, side by side along its long axis in the order
+  /// of their predictions: each centre lies this far inside the blob's end (half a body).
+  double merged_inset_m = 0.25;
+  double merged_sigma_m = 0.3;         ///< noise of that in-blob position
+  PredictorParams predictor;           ///< path prediction for predict_path classes
+  /// @throws romo::Error naming the field and value.
+  void Validate() const;
+};
+
+class Tracker {
+ public:
+  /// @throws romo::Error when @p params are invalid or the atlas lacks a "pedestrian" class.
+  Tracker(const Atlas& atlas, const TrackerParams& params);
+  ~Tracker();
+  Tracker(Tracker&&) noexcept;
+  Tracker& operator=(Tracker&&) noexcept;
+
+  /// Advances every track to @p stamp_s (strictly increasing), associates @p detections and
+  /// updates the lifecycle. Returns the live tracks (tentative, confirmed, lost).
+  /// @throws romo::Error when the stamp does not increase or a detection is not finite.
+  const std::vector<Track>& Update(double stamp_s, const std::vector<Detection>& detections);
+  const std::vector<Track>& tracks() const;
+
+  /// The yaw of the live track whose predicted position gates @p xy_m best, to pass to
+  /// FitVerticalBox as a heading hint; nullopt when none gates it.
+  std::optional<double> YawHint(const Eigen::Vector2d& xy_m) const;
+
+  const Atlas& atlas() const;
+  const TrackerParams& params() const;
+  /// Tracks ever created, and deleted (timed out).
+  int tracks_created() const;
+  int tracks_deleted() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace romo::objects

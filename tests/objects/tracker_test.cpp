@@ -1,0 +1,251 @@
+// Multi-object tracker on synthetic pedestrian scenes with known ground truth: crossings, total
+// occlusion (Fig. 4.16 middle) and two pedestrians merging into one blob (Fig. 4.16 bottom).
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "romo/core/check.hpp"
+#include "romo/objects/tracker.hpp"
+#include "romo/objects/tracking_eval.hpp"
+#include "test_support.hpp"
+
+namespace romo::objects {
+namespace {
+
+constexpr double kFrameS = 0.1;            // 10 Hz, the vehicle pipeline's rate
+constexpr double kDetectionNoiseM = 0.05;  // blob-centre jitter of a stereo pedestrian blob
+// Visible, separate pedestrians: the filter averages 5 cm noise; 0.1 m mean is 2 sigma.
+constexpr double kMeanErrorM = 0.10;
+// Worst frame incl. coasting through 1.5 s of occlusion and the merged frames: half a step.
+constexpr double kMaxErrorM = 0.45;
+// A track matches a pedestrian within this distance (ID-switch bookkeeping).
+constexpr double kMatchDistanceM = 1.0;
+
+struct Walker {
+  int id;
+  Eigen::Vector2d start;
+  Eigen::Vector2d velocity;
+  double hidden_from_s = -1.0;  // total occlusion interval
+  double hidden_to_s = -1.0;
+  // Piecewise: velocity until turn_s, velocity_after until turn2_s, velocity_after2 afterwards.
+  double turn_s = 1e9;
+  Eigen::Vector2d velocity_after = Eigen::Vector2d::Zero();
+  double turn2_s = 1e9;
+  Eigen::Vector2d velocity_after2 = Eigen::Vector2d::Zero();
+  Eigen::Vector2d At(double t) const {
+    return start + velocity * std::min(t, turn_s) +
+           velocity_after * std::clamp(t - turn_s, 0.0, turn2_s - turn_s) +
+           velocity_after2 * std::max(0.0, t - turn2_s);
+  }
+  bool Hidden(double t) const { return t >= hidden_from_s && t < hidden_to_s; }
+};
+
+Atlas LoadAtlas() { return Atlas::Load(test::SourcePath("config/atlas.yaml")); }
+
+Detection PedestrianBlob(const Atlas& atlas, const Eigen::Vector2d& xy, double yaw, double length,
+                         double width) {
+  Detection d;
+  d.xy_m = xy;
+  d.yaw_rad = yaw;
+  d.length_m = length;
+  d.width_m = width;
+  d.height_m = 1.75;
+  d.classification = atlas.Classify(length, width, d.height_m);
+  return d;
+}
+
+struct SceneResult {
+  TrackingScore score;
+  int merged_frames = 0;     // frames where two tracks shared one blob
+  int lost_frames = 0;       // frames with a coasting (lost) pedestrian track
+  int tracks_created = 0;
+};
+
+// Runs the tracker over walkers; two walkers closer than merge_distance_m produce one blob.
+SceneResult RunScene(const std::vector<Walker>& walkers, double duration_s,
+                     double merge_distance_m = 0.0, TrackerParams params = {}) {
+  const Atlas atlas = LoadAtlas();
+  Tracker tracker(atlas, params);
+  IdSwitchCounter counter(kMatchDistanceM);
+  std::mt19937 rng(42);
+  std::normal_distribution<double> noise(0.0, kDetectionNoiseM);
+  SceneResult result;
+  for (int frame = 0; frame * kFrameS <= duration_s; ++frame) {
+    const double t = frame * kFrameS;
+    std::vector<Detection> detections;
+    std::vector<IdPosition> truth;
+    std::vector<char> used(walkers.size(), 0);
+    for (std::size_t a = 0; a < walkers.size(); ++a) {
+      truth.push_back({walkers[a].id, walkers[a].At(t)});
+      if (walkers[a].Hidden(t) || used[a]) continue;
+      const Eigen::Vector2d pa = walkers[a].At(t);
+      bool merged = false;
+      for (std::size_t b = a + 1; b < walkers.size() && merge_distance_m > 0.0; ++b) {
+        if (walkers[b].Hidden(t) || used[b]) continue;
+        const Eigen::Vector2d pb = walkers[b].At(t);
+        const double dist = (pa - pb).norm();
+        if (dist < merge_distance_m) {
+          // One blob around both bodies (0.5 m each along the line joining them).
+          const Eigen::Vector2d centre = 0.5 * (pa + pb) + Eigen::Vector2d(noise(rng), noise(rng));
+          const double yaw = std::atan2(pb.y() - pa.y(), pb.x() - pa.x());
+          detections.push_back(PedestrianBlob(atlas, centre, yaw, dist + 0.5, 0.45));
+          used[b] = 1;
+          merged = true;
+          break;
+        }
+      }
+      if (!merged) {
+        detections.push_back(PedestrianBlob(atlas, pa + Eigen::Vector2d(noise(rng), noise(rng)),
+                                            0.3, 0.6, 0.4));
+      }
+    }
+    const auto& tracks = tracker.Update(t, detections);
+    std::vector<IdPosition> reported;
+    int merged_now = 0;
+    for (const Track& track : tracks) {
+      if (track.state == TrackState::kTentative) continue;
+      reported.push_back({track.id, track.xy_m});
+      merged_now += track.merged;
+      result.lost_frames += track.state == TrackState::kLost;
+    }
+    result.merged_frames += merged_now >= 2;
+    counter.AddFrame(truth, reported);
+  }
+  result.score = counter.score();
+  result.tracks_created = tracker.tracks_created();
+  return result;
+}
+
+TEST(TrackerTest, CrossingPedestriansKeepTheirIds) {
+  // Four walkers crossing an intersection area at right angles and head-on, 1.0-1.4 m/s,
+  // passing each other at >= 0.8 m.
+  const std::vector<Walker> walkers = {
+      {1, {-4.0, 0.0}, {1.3, 0.0}},
+      {2, {0.4, -4.0}, {0.0, 1.2}},
+      {3, {4.0, 0.8}, {-1.4, 0.0}},
+      {4, {-0.6, 4.0}, {0.1, -1.0}},
+  };
+  const SceneResult r = RunScene(walkers, 6.0);
+  EXPECT_EQ(r.score.id_switches, 0);
+  EXPECT_EQ(r.tracks_created, 4);
+  EXPECT_LT(r.score.mean_error_m, kMeanErrorM);
+  EXPECT_LT(r.score.max_error_m, kMaxErrorM);
+  // Only the first frames before confirmation (confirm_hits = 3) are unmatched.
+  EXPECT_LE(r.score.misses, 4 * 2);
+}
+
+TEST(TrackerTest, TotalOcclusionKeepsTrackAndReassociates) {
+  // Walker 1 is hidden for 1.5 s (behind walker 2, who passes in front of it) and reappears
+  // where its motion takes it.
+  std::vector<Walker> walkers = {
+      {1, {-3.0, 2.0}, {1.2, 0.0}, 2.0, 3.5},
+      {2, {3.0, 0.5}, {-1.0, 0.0}},
+  };
+  const SceneResult r = RunScene(walkers, 6.0);
+  EXPECT_EQ(r.score.id_switches, 0);
+  EXPECT_EQ(r.tracks_created, 2) << "the reappearing walker must not start a new track";
+  EXPECT_GE(r.lost_frames, 14);  // coasted through (almost) all 15 hidden frames
+  EXPECT_LT(r.score.max_error_m, kMaxErrorM);
+  EXPECT_EQ(r.score.misses, 2 * 2);  // only before confirmation
+}
+
+TEST(TrackerTest, OcclusionLongerThanLimitEndsTrack) {
+  TrackerParams params;
+  params.max_occlusion_s = 0.5;
+  Atlas atlas = LoadAtlas();
+  // The Atlas pedestrian class allows 2 s: the larger limit wins, so hide for 2.5 s.
+  const std::vector<Walker> walkers = {{1, {0.0, 0.0}, {1.0, 0.0}, 1.0, 3.5}};
+  const SceneResult r = RunScene(walkers, 5.0, 0.0, params);
+  EXPECT_EQ(r.tracks_created, 2);
+}
+
+TEST(TrackerTest, MergedPedestriansBothSurviveAndSplit) {
+  // Two walkers pass each other head-on 0.6 m apart: for ~0.6 s stereo sees one blob
+  // (Fig. 4.16 bottom); both tracks must share it and come out with their own ids.
+  const std::vector<Walker> walkers = {
+      {1, {-3.0, 0.0}, {1.2, 0.0}},
+      {2, {3.0, 0.6}, {-1.2, 0.0}},
+  };
+  const SceneResult r = RunScene(walkers, 5.0, 0.9);
+  EXPECT_EQ(r.score.id_switches, 0);
+  EXPECT_EQ(r.tracks_created, 2);
+  EXPECT_GE(r.merged_frames, 3);
+  EXPECT_LT(r.score.max_error_m, kMaxErrorM);
+  EXPECT_LT(r.score.mean_error_m, kMeanErrorM);
+}
+
+TEST(TrackerTest, WalkingTogetherThenSplittingKeepsBothTracks) {
+  // Walker 2 joins walker 1 from the side, they walk 0.6 m apart (one blob) for 2 s, then
+  // walker 2 turns away at 45 degrees.
+  std::vector<Walker> walkers = {
+      {1, {-3.0, 0.0}, {1.0, 0.0}},
+      {2, {-3.0, 2.1}, {1.0, -0.75}},
+  };
+  walkers[1].turn_s = 2.0;  // now at (-1, 0.6)
+  walkers[1].velocity_after = Eigen::Vector2d(1.0, 0.0);
+  walkers[1].turn2_s = 4.0;
+  walkers[1].velocity_after2 = Eigen::Vector2d(0.8, 0.8);
+  const SceneResult r = RunScene(walkers, 7.0, 0.9);
+  EXPECT_EQ(r.score.id_switches, 0);
+  EXPECT_EQ(r.tracks_created, 2);
+  EXPECT_GE(r.merged_frames, 15);
+  EXPECT_LT(r.score.max_error_m, kMaxErrorM);
+}
+
+TEST(TrackerTest, PedestrianTracksCarryPredictedPath) {
+  const Atlas atlas = LoadAtlas();
+  Tracker tracker(atlas, TrackerParams{});
+  for (int k = 0; k < 20; ++k) {
+    tracker.Update(k * kFrameS,
+                   {PedestrianBlob(atlas, Eigen::Vector2d(1.0 * k * kFrameS, 0.0), 0.0, 0.6, 0.4)});
+  }
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  const Track& t = tracker.tracks()[0];
+  EXPECT_EQ(t.state, TrackState::kConfirmed);
+  EXPECT_EQ(atlas.classes()[t.class_index].name, "pedestrian");
+  ASSERT_EQ(t.predicted_path.size(), 48u);  // 4.8 s at 10 Hz
+  // Straight 1 m/s walk, no noise: the path ends 4.8 m ahead.
+  EXPECT_NEAR(t.predicted_path.back().xy_m.x(), 1.9 + 4.8, 1e-6);
+  // Hidden now: the path is kept unchanged while the track coasts.
+  const auto path = t.predicted_path;
+  tracker.Update(2.0, {});
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks()[0].state, TrackState::kLost);
+  EXPECT_EQ(tracker.tracks()[0].predicted_path.size(), path.size());
+  EXPECT_DOUBLE_EQ(tracker.tracks()[0].predicted_path.back().xy_m.x(), path.back().xy_m.x());
+}
+
+TEST(TrackerTest, YawStaysContinuousModuloPi) {
+  const Atlas atlas = LoadAtlas();
+  Tracker tracker(atlas, TrackerParams{});
+  // The box fit reports a heading that flips by pi (same box): the track must not flip.
+  for (int k = 0; k < 10; ++k) {
+    const double yaw = 1.4 + (k % 2 == 0 ? 0.0 : -M_PI) + 0.02 * k;
+    tracker.Update(k * kFrameS, {PedestrianBlob(atlas, Eigen::Vector2d(0.0, 0.1 * k), yaw, 0.7, 0.4)});
+    if (k > 0) {
+      EXPECT_NEAR(tracker.tracks()[0].yaw_rad, 1.4 + 0.02 * k, 1e-5) << "frame " << k;
+    }
+  }
+  const auto hint = tracker.YawHint(Eigen::Vector2d(0.0, 1.0));
+  ASSERT_TRUE(hint.has_value());
+  EXPECT_NEAR(*hint, 1.4 + 0.18, 1e-5);
+  EXPECT_FALSE(tracker.YawHint(Eigen::Vector2d(50.0, 0.0)).has_value());
+}
+
+TEST(TrackerTest, RejectsBadInput) {
+  const Atlas atlas = LoadAtlas();
+  TrackerParams params;
+  params.gate_chi2 = -1.0;
+  EXPECT_THROW(Tracker(atlas, params), romo::Error);
+  Tracker tracker(atlas, TrackerParams{});
+  tracker.Update(1.0, {});
+  EXPECT_THROW(tracker.Update(1.0, {}), romo::Error);
+  Detection bad;
+  bad.xy_m.x() = std::nan("");
+  EXPECT_THROW(tracker.Update(2.0, {bad}), romo::Error);
+}
+
+}  // namespace
+}  // namespace romo::objects
