@@ -1,5 +1,7 @@
 #include "romo/indoor_manip/hand_kalman.hpp"
 
+#include <Eigen/Dense>
+
 #include <string>
 
 #include "romo/core/check.hpp"

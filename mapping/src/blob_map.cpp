@@ -1,5 +1,7 @@
 #include "romo/mapping/blob_map.hpp"
 
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <limits>
 #include <string>

@@ -1,5 +1,7 @@
 #include "romo/mapping/ego_motion.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
