@@ -16,26 +16,61 @@ void IdSwitchCounter::AddFrame(const std::vector<IdPosition>& ground_truth,
                                const std::vector<IdPosition>& tracks) {
   ++score_.frames;
   score_.ground_truth_instances += static_cast<std::int64_t>(ground_truth.size());
-  Eigen::MatrixXd cost(static_cast<Eigen::Index>(ground_truth.size()),
-                       static_cast<Eigen::Index>(tracks.size()));
+  auto last_track_of = [&](int object) -> int {
+    auto it = std::lower_bound(last_match_.begin(), last_match_.end(), std::make_pair(object, 0),
+                               [](const auto& x, const auto& y) { return x.first < y.first; });
+    return it != last_match_.end() && it->first == object ? it->second : -1;
+  };
+  // CLEAR-MOT: a correspondence from the previous frame is kept while it is still within the
+  // match distance (two close objects must not trade tracks just because the minimum-distance
+  // matching flips); the rest is matched optimally.
+  std::vector<int> match(ground_truth.size(), -1);  // track index per object
+  std::vector<char> track_taken(tracks.size(), 0);
   for (std::size_t g = 0; g < ground_truth.size(); ++g) {
+    const int previous = last_track_of(ground_truth[g].id);
+    if (previous < 0) continue;
     for (std::size_t t = 0; t < tracks.size(); ++t) {
-      const double d = (ground_truth[g].xy_m - tracks[t].xy_m).norm();
+      if (tracks[t].id == previous && !track_taken[t] &&
+          (ground_truth[g].xy_m - tracks[t].xy_m).norm() <= max_match_distance_m_) {
+        match[g] = static_cast<int>(t);
+        track_taken[t] = 1;
+        break;
+      }
+    }
+  }
+  std::vector<int> free_objects, free_tracks;
+  for (std::size_t g = 0; g < ground_truth.size(); ++g) {
+    if (match[g] < 0) free_objects.push_back(static_cast<int>(g));
+  }
+  for (std::size_t t = 0; t < tracks.size(); ++t) {
+    if (!track_taken[t]) free_tracks.push_back(static_cast<int>(t));
+  }
+  Eigen::MatrixXd cost(static_cast<Eigen::Index>(free_objects.size()),
+                       static_cast<Eigen::Index>(free_tracks.size()));
+  for (std::size_t g = 0; g < free_objects.size(); ++g) {
+    for (std::size_t t = 0; t < free_tracks.size(); ++t) {
+      const double d = (ground_truth[static_cast<std::size_t>(free_objects[g])].xy_m -
+                        tracks[static_cast<std::size_t>(free_tracks[t])].xy_m).norm();
       cost(static_cast<Eigen::Index>(g), static_cast<Eigen::Index>(t)) =
           d <= max_match_distance_m_ ? d : kForbiddenCost;
     }
   }
   const Assignment a = SolveAssignment(cost);
+  for (std::size_t g = 0; g < free_objects.size(); ++g) {
+    if (a.row_to_col[g] >= 0) {
+      match[static_cast<std::size_t>(free_objects[g])] = free_tracks[static_cast<std::size_t>(a.row_to_col[g])];
+    }
+  }
   std::int64_t matched_tracks = 0;
   for (std::size_t g = 0; g < ground_truth.size(); ++g) {
-    const int t = a.row_to_col[g];
+    const int t = match[g];
     if (t < 0) {
       ++score_.misses;
       continue;
     }
     ++score_.matches;
     ++matched_tracks;
-    const double e = cost(static_cast<Eigen::Index>(g), t);
+    const double e = (ground_truth[g].xy_m - tracks[static_cast<std::size_t>(t)].xy_m).norm();
     error_sum_m_ += e;
     score_.max_error_m = std::max(score_.max_error_m, e);
     const int object = ground_truth[g].id;

@@ -24,9 +24,10 @@ struct TrackingScore {
   double max_error_m = 0.0;
 };
 
-/// Counts ID switches frame by frame: tracks and objects are matched one-to-one by minimum total
-/// distance (Hungarian) within max_match_distance_m; an object whose matched track id differs
-/// from the id it was last matched to counts one switch.
+/// Counts ID switches frame by frame (CLEAR-MOT): an object keeps last frame's track while it is
+/// within max_match_distance_m; the other objects and tracks are matched one-to-one by minimum
+/// total distance (Hungarian) within it. An object whose matched track id differs from the id it
+/// was last matched to counts one switch.
 class IdSwitchCounter {
  public:
   explicit IdSwitchCounter(double max_match_distance_m = 1.0);
