@@ -1,5 +1,6 @@
 #include "romo/sim/ground_truth.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "romo/core/check.hpp"
@@ -26,6 +27,28 @@ std::vector<Eigen::Vector2d> GtBox::Footprint() const {
   const double hl = size_m.x() / 2, hw = size_m.y() / 2;
   return {o - hl * ax - hw * ay, o + hl * ax - hw * ay, o + hl * ax + hw * ay,
           o - hl * ax + hw * ay};
+}
+
+bool FootprintsOverlap(const GtBox& a, const GtBox& b) {
+  const auto pa = a.Footprint(), pb = b.Footprint();
+  // Two convex rectangles are disjoint iff some edge normal of either separates them.
+  for (const auto* poly : {&pa, &pb}) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Eigen::Vector2d e = (*poly)[(i + 1) % 4] - (*poly)[i];
+      const Eigen::Vector2d n(-e.y(), e.x());
+      double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
+      for (const auto& p : pa) {
+        amin = std::min(amin, n.dot(p));
+        amax = std::max(amax, n.dot(p));
+      }
+      for (const auto& p : pb) {
+        bmin = std::min(bmin, n.dot(p));
+        bmax = std::max(bmax, n.dot(p));
+      }
+      if (amax < bmin || bmax < amin) return false;
+    }
+  }
+  return true;
 }
 
 GtBox GtBay::AsBox(double height_m) const {

@@ -24,6 +24,9 @@ bool ParseFlag(const drivers::Uri& uri, const std::string& key, bool fallback) {
 void SimParams::Validate() const {
   if (scene != "parking") Fail("unknown simulator scene '" + scene + "' (known: parking)");
   if (frames <= 0) Fail("simulator frames = " + std::to_string(frames) + " must be > 0");
+  if (first_frame < 0) {
+    Fail("simulator first frame = " + std::to_string(first_frame) + " must be >= 0");
+  }
   if (!(rate_hz >= 0.5 && rate_hz <= 100.0)) {
     Fail("simulator rate_hz = " + std::to_string(rate_hz) + " is outside 0.5-100");
   }
@@ -36,7 +39,7 @@ void SimParams::Validate() const {
 SimParams SimParams::FromUri(const drivers::Uri& uri) {
   static const std::set<std::string> kKeys = {"seed",  "frames",     "rate_hz", "scale",
                                               "depth", "distortion", "calib",   "start_ns",
-                                              "aa",    "noise",      "threads"};
+                                              "aa",    "noise",      "threads", "first"};
   for (const auto& [key, value] : uri.query) {
     if (kKeys.count(key) == 0) {
       std::string known;
@@ -52,6 +55,7 @@ SimParams SimParams::FromUri(const drivers::Uri& uri) {
     p.seed = static_cast<std::uint64_t>(*v);
   }
   if (const auto v = uri.GetInt("frames")) p.frames = *v;
+  if (const auto v = uri.GetInt("first")) p.first_frame = *v;
   if (const auto v = uri.GetDouble("rate_hz")) p.rate_hz = *v;
   if (const auto v = uri.GetDouble("scale")) p.scale = *v;
   p.depth = ParseFlag(uri, "depth", p.depth);
@@ -124,7 +128,7 @@ class SimSource::Impl {
 
   std::optional<drivers::FrameSet> Next() {
     if (next_ >= static_cast<std::uint64_t>(params_.frames)) return std::nullopt;
-    const std::uint64_t index = next_++;
+    const std::uint64_t index = static_cast<std::uint64_t>(params_.first_frame) + next_++;
     truth_ = Truth(index);
     const SceneSnapshot snap = scene_.At(TimeOf(index));
     drivers::FrameSet set;

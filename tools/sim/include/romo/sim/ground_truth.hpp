@@ -33,6 +33,10 @@ struct GtBox {
   std::vector<Eigen::Vector2d> Footprint() const;
 };
 
+/// True when the footprints of @p a and @p b overlap (separating-axis test on the ground plane;
+/// heights are ignored: everything stands on the ground).
+bool FootprintsOverlap(const GtBox& a, const GtBox& b);
+
 /// A free parking bay between two parked cars.
 struct GtBay {
   int id = 0;

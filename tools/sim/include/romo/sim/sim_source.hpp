@@ -20,6 +20,7 @@ struct SimParams {
   std::string scene = "parking";       ///< URI path; only "parking" so far
   std::uint64_t seed = 1;              ///< [seed] scene layout, pedestrians, sensor noise
   long long frames = 150;              ///< [frames] > 0; 150 frames cover the whole maneuver
+  long long first_frame = 0;           ///< [first] index of the first frame delivered (>= 0)
   double rate_hz = 10.0;               ///< [rate_hz] frame rate, 0.5-100
   double scale = 1.0;                  ///< [scale] image scale (0, 4], calibration scaled to match
   bool depth = false;                  ///< [depth=0|1] per-pixel truth with every frame
