@@ -1,0 +1,122 @@
+#include "romo/stereo/reprojection.hpp"
+
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+#include "romo/core/check.hpp"
+#include "romo/stereo/sgm.hpp"
+#include "romo/stereo/synthetic.hpp"
+#include "stereo_test_rigs.hpp"
+
+namespace romo::stereo {
+namespace {
+
+RectifiedGeometry Geometry(int width, int height) {
+  RectifiedGeometry g;
+  g.focal_px = 400.0;
+  g.baseline_m = 0.25;
+  g.cx_px = (width - 1) / 2.0;
+  g.cy_px = (height - 1) / 2.0;
+  return g;
+}
+
+// Matches a rendered plane with romo's defaults and checks every reprojected point against the
+// analytic plane along its own viewing ray: the mean depth error must lie within the mean
+// sigma_z that eq. 2.3 predicts (sigma_d = 0.25 px).
+void ExpectPlaneWithinSigma(const Eigen::Vector3d& normal, double distance_m) {
+  constexpr int kW = 321, kH = 241;  // odd on purpose
+  const RectifiedGeometry g = Geometry(kW, kH);
+  const SyntheticPair pair = RenderPlanePair(g, kW, kH, normal, distance_m, 5);
+  StereoSgm sgm(kW, kH, 48, 8, 16);
+  cv::Mat d;
+  sgm.execute(pair.left, pair.right, &d);
+  const PointCloud cloud = ReprojectDisparity(d, sgm.subpixel_scale(), sgm.get_invalid_disparity(), pair.left, g,
+                                              ReprojectionParams{});
+  ASSERT_GT(cloud.size(), static_cast<std::size_t>(kW * kH / 2));
+  const Eigen::Vector3d n = normal.normalized();
+  double sum_abs_err = 0.0, sum_sigma = 0.0;
+  for (Eigen::Index i = 0; i < cloud.xyz.cols(); ++i) {
+    const Eigen::Vector3d p = cloud.xyz.col(i).cast<double>();
+    const Eigen::Vector3d ray = p / p.z();
+    const double z_true = distance_m / n.dot(ray);
+    sum_abs_err += std::abs(p.z() - z_true);
+    sum_sigma += cloud.sigma_z_m[static_cast<std::size_t>(i)];
+  }
+  const double mean_err = sum_abs_err / cloud.size(), mean_sigma = sum_sigma / cloud.size();
+  std::printf("plane n=(%.2f %.2f %.2f) c=%.1f m: %zu points, mean |dz| %.4f m, mean sigma_z %.4f m\n", n.x(), n.y(),
+              n.z(), distance_m, cloud.size(), mean_err, mean_sigma);
+  EXPECT_LE(mean_err, mean_sigma);
+}
+
+TEST(ReprojectionTest, FrontoParallelPlaneWithinSigmaZ) { ExpectPlaneWithinSigma({0, 0, 1}, 6.0); }
+
+TEST(ReprojectionTest, TiltedPlaneWithinSigmaZ) { ExpectPlaneWithinSigma({0.5, 0.2, 0.84}, 5.0); }
+
+// Against OpenCV's reprojectImageTo3D with the rectifier's Q (the reference) on an odd size.
+TEST(ReprojectionTest, MatchesOpenCvReprojectImageTo3D) {
+  const Rectifier rect(testing::MakeRig(0, 161, 97));
+  cv::Mat d(97, 161, CV_16SC1);
+  cv::RNG rng(2);
+  rng.fill(d, cv::RNG::UNIFORM, 32, 960);
+  for (int i = 0; i < 500; ++i) d.at<short>(rng.uniform(0, 97), rng.uniform(0, 161)) = -16;
+  ReprojectionParams params;
+  params.max_range_m = 1e6;  // keep everything
+  const PointCloud cloud = ReprojectDisparity(d, 16, -16, cv::Mat(), rect.geometry(), params);
+  cv::Mat df, xyz;
+  d.convertTo(df, CV_32F, 1.0 / 16);
+  cv::reprojectImageTo3D(df, xyz, rect.Q());
+  // float arithmetic on metre-scale coordinates: 1e-4 relative.
+  constexpr double kRelTol = 1e-4;
+  Eigen::Index k = 0;
+  for (int y = 0; y < d.rows; ++y) {
+    for (int x = 0; x < d.cols; ++x) {
+      if (d.at<short>(y, x) == -16) continue;
+      const cv::Vec3f r = xyz.at<cv::Vec3f>(y, x);
+      const Eigen::Vector3d expected = rect.geometry().R_rig_rect * Eigen::Vector3d(r[0], r[1], r[2]);
+      ASSERT_LT(k, cloud.xyz.cols());
+      ASSERT_LE((cloud.xyz.col(k).cast<double>() - expected).norm(), kRelTol * expected.norm()) << x << "," << y;
+      ++k;
+    }
+  }
+  EXPECT_EQ(k, cloud.xyz.cols());
+}
+
+TEST(ReprojectionTest, SigmaZRangeLimitAndVehicleFrame) {
+  cv::Mat d(3, 5, CV_16SC1, cv::Scalar(-16));
+  const RectifiedGeometry g = Geometry(5, 3);  // cx = 2, cy = 1
+  d.at<short>(1, 2) = 10 * 16;  // 10 px at the principal point: Z = 0.25 * 400 / 10 = 10 m
+  ReprojectionParams params;
+  params.sigma_d_px = 0.5;
+  const drivers::RigCalibration rig = testing::MakeRig(0, 5, 3);
+  const PointCloud cloud = ReprojectDisparity(d, 16, -16, cv::Mat(), g, params, rig.T_vehicle_rig);
+  ASSERT_EQ(cloud.size(), 1u);
+  // Eq. 2.3: sigma_z = Z^2 / (b f) * sigma_d = 100 / 100 * 0.5.
+  constexpr float kTolM = 1e-5f;
+  EXPECT_NEAR(cloud.sigma_z_m[0], 0.5f, kTolM);
+  // 10 m along the optical axis, pitched down 15 deg from (1.4, 0, 1.2).
+  const double pitch = 15.0 * M_PI / 180.0;
+  EXPECT_NEAR(cloud.xyz(0, 0), 1.4 + 10.0 * std::cos(pitch), 1e-4);
+  EXPECT_NEAR(cloud.xyz(1, 0), 0.0, 1e-4);
+  EXPECT_NEAR(cloud.xyz(2, 0), 1.2 - 10.0 * std::sin(pitch), 1e-4);
+  params.max_range_m = 9.0;
+  EXPECT_TRUE(ReprojectDisparity(d, 16, -16, cv::Mat(), g, params).empty());
+}
+
+TEST(ReprojectionTest, RejectsBadInput) {
+  const RectifiedGeometry g = Geometry(5, 3);
+  EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_32FC1), 16, -16, cv::Mat(), g, {}), Error);
+  EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(4, 5, CV_8UC1), g, {}), Error);
+  ReprojectionParams bad;
+  bad.max_range_m = 0.0;
+  EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(), g, bad), Error);
+  RectifiedGeometry no_baseline = g;
+  no_baseline.baseline_m = 0.0;
+  EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(), no_baseline, {}), Error);
+}
+
+}  // namespace
+}  // namespace romo::stereo
