@@ -183,12 +183,13 @@ ActionFeatures ComputeActionFeatures(const MotionProfiles& p,
   f.periodicity_r = Periodicity(p.r_m, dt, &f.period_r_s);
 
   // Sawtooth: slow constant advance and fast returns give a strongly skewed velocity along the
-  // row axis; the larger in-plane span is the row axis.
-  const auto& row = f.x_range_m >= f.y_range_m ? p.x_m : p.y_m;
-  const auto row_s = Smooth(row, 2);
-  std::vector<double> v_row(n - 1);
-  for (std::size_t i = 0; i + 1 < n; ++i) v_row[i] = (row_s[i + 1] - row_s[i]) / dt;
-  f.sawtooth = std::abs(Skewness(v_row));
+  // row axis (x for western rows, y for vertical ones): the larger |skewness| of the two.
+  for (const auto* axis : {&p.x_m, &p.y_m}) {
+    const auto sm = Smooth(*axis, 2);
+    std::vector<double> vel(n - 1);
+    for (std::size_t i = 0; i + 1 < n; ++i) vel[i] = (sm[i + 1] - sm[i]) / dt;
+    f.sawtooth = std::max(f.sawtooth, std::abs(Skewness(vel)));
+  }
 
   const auto r_s = Smooth(p.r_m, 1);
   const double min_prom = 0.03;  // 3 cm: above the hand's depth noise, below any real stroke
@@ -218,14 +219,13 @@ ActionFeatures ComputeActionFeatures(const MotionProfiles& p,
   }
   f.peak_inflection_fraction = high > 0 ? static_cast<double>(paused) / high : 0.0;
 
-  // Rotation spread: standard deviation of the cumulative angle per axis (degrees).
+  // Rotation spread: standard deviation of the per-step angle per axis (degrees per frame); the
+  // spread of the per-step histogram, unaffected by the drift of the cumulative angle.
   if (!rotation_steps_rad.empty()) {
-    Eigen::Vector3d cum = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero(),
-                    sq = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sq = Eigen::Vector3d::Zero();
     for (const auto& s : rotation_steps_rad) {
-      cum += s;
-      sum += cum;
-      sq += cum.cwiseProduct(cum);
+      sum += s;
+      sq += s.cwiseProduct(s);
     }
     const double m = static_cast<double>(rotation_steps_rad.size());
     const Eigen::Vector3d var = (sq / m - (sum / m).cwiseProduct(sum / m)).cwiseMax(0.0);
@@ -241,6 +241,8 @@ void ActionThresholds::Validate() const {
     if (!(v > 0.0)) Fail(std::string("thresholds.") + name + " must be > 0, got " + std::to_string(v));
   };
   positive(tightening_rotation_deg, "tightening_rotation_deg");
+  positive(tightening_max_xy_range_m, "tightening_max_xy_range_m");
+  positive(tightening_max_spike_rate_hz, "tightening_max_spike_rate_hz");
   positive(high_peak_m, "high_peak_m");
   positive(hitting_descent_mps, "hitting_descent_mps");
   positive(drinking_peak_m, "drinking_peak_m");
@@ -248,11 +250,9 @@ void ActionThresholds::Validate() const {
   positive(sawtooth, "sawtooth");
   positive(sawtooth_periodicity, "sawtooth_periodicity");
   positive(board_row_length_m, "board_row_length_m");
-  positive(poking_spike_rate_hz, "poking_spike_rate_hz");
-  positive(poking_max_xy_range_m, "poking_max_xy_range_m");
-  positive(pulling_periodicity, "pulling_periodicity");
-  positive(pulling_min_period_s, "pulling_min_period_s");
-  positive(chopping_periodicity, "chopping_periodicity");
+  positive(stroke_spike_rate_hz, "stroke_spike_rate_hz");
+  positive(regular_periodicity, "regular_periodicity");
+  positive(pulling_min_r_range_m, "pulling_min_r_range_m");
 }
 
 namespace {
@@ -267,13 +267,16 @@ std::string Cmp(const char* name, double value, const char* op, double threshold
 ActionDecision ClassifyAction(const ActionFeatures& f, const ActionThresholds& t) {
   ActionDecision d;
   auto& why = d.reasons;
-  // 1. Tightening is the only action dominated by wrist turns about the plane normal.
-  if (f.rotation_spread_z_deg > t.tightening_rotation_deg) {
+  const double xy = std::max(f.x_range_m, f.y_range_m);
+  // 1. Tightening: wrist turns about the plane normal with only short translations (Table 6.2).
+  if (f.rotation_spread_z_deg > t.tightening_rotation_deg && xy < t.tightening_max_xy_range_m &&
+      f.spike_rate_hz < t.tightening_max_spike_rate_hz) {
     why.push_back(Cmp("rotation_spread_z_deg", f.rotation_spread_z_deg, ">", t.tightening_rotation_deg));
+    why.push_back(Cmp("xy_range_m", xy, "<", t.tightening_max_xy_range_m));
+    why.push_back(Cmp("spike_rate_hz", f.spike_rate_hz, "<", t.tightening_max_spike_rate_hz));
     d.label = "tightening";
     return d;
   }
-  why.push_back(Cmp("rotation_spread_z_deg", f.rotation_spread_z_deg, "<=", t.tightening_rotation_deg));
   // 2. Actions that lift the hand far from the plane: hammer blows, fork and glass to the mouth.
   if (f.peak_height_m > t.high_peak_m) {
     why.push_back(Cmp("peak_height_m", f.peak_height_m, ">", t.high_peak_m));
@@ -297,36 +300,29 @@ ActionDecision ClassifyAction(const ActionFeatures& f, const ActionThresholds& t
   if (f.sawtooth > t.sawtooth && row_period > t.sawtooth_periodicity) {
     why.push_back(Cmp("sawtooth", f.sawtooth, ">", t.sawtooth));
     why.push_back(Cmp("row_periodicity", row_period, ">", t.sawtooth_periodicity));
-    const double row_len = std::max(f.x_range_m, f.y_range_m);
-    const bool board = row_len > t.board_row_length_m;
-    why.push_back(Cmp("row_length_m", row_len, board ? ">" : "<=", t.board_row_length_m));
+    const bool board = xy > t.board_row_length_m;
+    why.push_back(Cmp("row_length_m", xy, board ? ">" : "<=", t.board_row_length_m));
     d.label = board ? "writing" : "writing_pen";
     return d;
   }
   why.push_back(Cmp("sawtooth", f.sawtooth, "<=", t.sawtooth) + " or " +
                 Cmp("row_periodicity", row_period, "<=", t.sawtooth_periodicity));
-  // 4. Poking: frequent spikes in the distance to the plane around one spot.
-  const double xy = std::max(f.x_range_m, f.y_range_m);
-  if (f.spike_rate_hz > t.poking_spike_rate_hz && xy < t.poking_max_xy_range_m &&
-      f.periodicity_r < t.pulling_periodicity) {
-    why.push_back(Cmp("spike_rate_hz", f.spike_rate_hz, ">", t.poking_spike_rate_hz));
-    why.push_back(Cmp("xy_range_m", xy, "<", t.poking_max_xy_range_m));
-    d.label = "poking";
+  // 4. Strokes towards the plane: irregular ones poke, regular ones chop.
+  const bool regular = f.periodicity_r > t.regular_periodicity;
+  if (f.spike_rate_hz > t.stroke_spike_rate_hz) {
+    why.push_back(Cmp("spike_rate_hz", f.spike_rate_hz, ">", t.stroke_spike_rate_hz));
+    why.push_back(Cmp("periodicity_r", f.periodicity_r, regular ? ">" : "<=", t.regular_periodicity));
+    d.label = regular ? "chopping" : "poking";
     return d;
   }
-  // 5. Pulling: a slow, regular rocking in the distance to the plane.
-  if (f.periodicity_r > t.pulling_periodicity && f.period_r_s > t.pulling_min_period_s &&
-      xy < 2 * t.poking_max_xy_range_m) {
-    why.push_back(Cmp("periodicity_r", f.periodicity_r, ">", t.pulling_periodicity));
-    why.push_back(Cmp("period_r_s", f.period_r_s, ">", t.pulling_min_period_s));
-    d.label = "pulling";
-    return d;
-  }
-  // 6. Chopping: quasi-periodic strokes; erasing: arbitrary strokes.
-  const double per = std::max(f.periodicity_y, f.periodicity_r);
-  const bool periodic = per > t.chopping_periodicity;
-  why.push_back(Cmp("stroke_periodicity", per, periodic ? ">" : "<=", t.chopping_periodicity));
-  d.label = periodic ? "chopping" : "erasing";
+  why.push_back(Cmp("spike_rate_hz", f.spike_rate_hz, "<=", t.stroke_spike_rate_hz));
+  // 5. Pulling: a slow, regular rocking of the distance to the plane; erasing: arbitrary strokes
+  // close to the plane.
+  const bool rocking = regular && f.r_range_m > t.pulling_min_r_range_m;
+  why.push_back(Cmp("periodicity_r", f.periodicity_r, regular ? ">" : "<=", t.regular_periodicity));
+  why.push_back(Cmp("r_range_m", f.r_range_m, f.r_range_m > t.pulling_min_r_range_m ? ">" : "<=",
+                    t.pulling_min_r_range_m));
+  d.label = rocking ? "pulling" : "erasing";
   return d;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
 #include "romo/core/check.hpp"
@@ -85,17 +86,27 @@ RotationStep EstimateHandRotation(const RgbdImage& prev, const RgbdImage& next,
                                  bbox_prev.height + 2 * pad)) &
                        cv::Rect(0, 0, prev.width(), prev.height());
   if (roi.width < 8 || roi.height < 8) return step;
-  cv::Mat flow;
-  cv::calcOpticalFlowFarneback(prev.gray(roi), next.gray(roi), flow, 0.5, 3, 13, 3, 5, 1.1, 0);
-  const int area = std::max(1, cv::countNonZero(mask_prev(roi)));
+  // A Kinect hand covers only a few hundred pixels: flow on a 2x upsampled window resolves its
+  // texture, and an eroded mask keeps vectors off the silhouette, where the static background
+  // drags the flow towards zero.
+  constexpr double kScale = 2.0;
+  cv::Mat prev_up, next_up, flow;
+  cv::resize(prev.gray(roi), prev_up, cv::Size(), kScale, kScale, cv::INTER_LINEAR);
+  cv::resize(next.gray(roi), next_up, cv::Size(), kScale, kScale, cv::INTER_LINEAR);
+  cv::calcOpticalFlowFarneback(prev_up, next_up, flow, 0.5, 3, 11, 3, 5, 1.1, 0);
+  cv::Mat mask;
+  cv::erode(mask_prev(roi), mask, cv::Mat(), cv::Point(-1, -1), 1);
+  if (cv::countNonZero(mask) < params.min_vectors) mask = mask_prev(roi);
+  const int area = std::max(1, cv::countNonZero(mask));
   const int stride = std::max(1, static_cast<int>(std::sqrt(area / double(params.max_vectors))));
   std::vector<Eigen::Vector3d> p0, p1;
   for (int y = 0; y < roi.height; y += stride) {
     for (int x = 0; x < roi.width; x += stride) {
+      if (mask.at<std::uint8_t>(y, x) == 0) continue;
       const int u = x + roi.x, v = y + roi.y;
-      if (mask_prev.at<std::uint8_t>(v, u) == 0) continue;
       const float z0 = prev.depth_m.at<float>(v, u);
-      const cv::Point2f f = flow.at<cv::Point2f>(y, x);
+      const cv::Point2f fu = flow.at<cv::Point2f>(static_cast<int>(y * kScale), static_cast<int>(x * kScale));
+      const cv::Point2f f(fu.x / kScale, fu.y / kScale);
       const float ue = u + f.x, ve = v + f.y;
       const int ui = static_cast<int>(std::lround(ue)), vi = static_cast<int>(std::lround(ve));
       if (ui < 0 || vi < 0 || ui >= next.width() || vi >= next.height()) continue;

@@ -157,30 +157,25 @@ class SimManipScene::Impl {
     rig.left.K = K_;
     rig.right.K = K_;
     calibration_.rigs.push_back(rig);
+    RenderBackground();
   }
 
-  drivers::RgbdFrame Render(int k) const {
-    ROMO_THROW_UNLESS(k >= 0 && k < opt_.frames);
+  // Ray parameter of pixel (u, v): its direction with camera-frame z = 1, so t is the depth.
+  Eigen::Vector3d Ray(int u, int v) const {
+    return R_P_C_ * Eigen::Vector3d((u - K_(0, 2)) / K_(0, 0), (v - K_(1, 2)) / K_(1, 1), 1.0);
+  }
+
+  // The static part (plane and objects) is rendered once; frames only re-cast the hand.
+  void RenderBackground() {
     const int w = opt_.width_px, h = opt_.height_px;
-    const internal::HandPose& hp = path_[k];
-    const Eigen::Vector3d hand_c(hp.u_m, hp.v_m, hp.h_m);
-    const Eigen::Matrix3d R_P_H =
-        (Eigen::AngleAxisd(hp.yaw_rad, Eigen::Vector3d::UnitZ()) *
-         Eigen::AngleAxisd(hp.pitch_rad, Eigen::Vector3d::UnitX()) *
-         Eigen::AngleAxisd(hp.roll_rad, Eigen::Vector3d::UnitY()))
-            .toRotationMatrix();
-    const Eigen::Vector3d light = Eigen::Vector3d(0.3, -0.4, 1.0).normalized();
-    std::vector<double> depth(static_cast<std::size_t>(w) * h, 0.0);
-    std::vector<Eigen::Vector3d> colour(depth.size(), Eigen::Vector3d::Zero());
-    const double fx = K_(0, 0), fy = K_(1, 1), cx = K_(0, 2), cy = K_(1, 2);
+    bg_depth_.assign(static_cast<std::size_t>(w) * h, 0.0);
+    bg_colour_.assign(bg_depth_.size(), Eigen::Vector3f::Zero());
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
-        // Direction with camera-frame z = 1: the ray parameter is the depth itself.
-        const Eigen::Vector3d d = R_P_C_ * Eigen::Vector3d((u - cx) / fx, (v - cy) / fy, 1.0);
+        const Eigen::Vector3d d = Ray(u, v);
         double best = kInf;
         Eigen::Vector3d rgb(0, 0, 0);
-        // Plane z = 0.
-        if (d.z() < -1e-9) {
+        if (d.z() < -1e-9) {  // plane z = 0
           const double t = -eye_.z() / d.z();
           const Eigen::Vector3d p = eye_ + t * d;
           best = t;
@@ -213,29 +208,66 @@ class SimManipScene::Impl {
             rgb = b.rgb * shade * (0.85 + 0.15 * ValueNoise(p.x() + p.z(), p.y() - p.z(), 0.01, 13));
           }
         }
+        if (best < 6.0) {
+          const std::size_t i = static_cast<std::size_t>(v) * w + u;
+          bg_depth_[i] = best;
+          bg_colour_[i] = rgb.cast<float>();
+        }
+      }
+    }
+    // A fixed table of standard normal samples: per-frame noise is a seeded walk through it.
+    std::mt19937_64 rng(salt_ ^ 0x6A09E667F3BCC909ull);
+    std::normal_distribution<float> gauss(0.f, 1.f);
+    noise_.resize(1 << 18);
+    for (auto& n : noise_) n = gauss(rng);
+  }
+
+  drivers::RgbdFrame Render(int k) const {
+    ROMO_THROW_UNLESS(k >= 0 && k < opt_.frames);
+    const int w = opt_.width_px, h = opt_.height_px;
+    const internal::HandPose& hp = path_[k];
+    const Eigen::Vector3d hand_c(hp.u_m, hp.v_m, hp.h_m);
+    const Eigen::Matrix3d R_P_H =
+        (Eigen::AngleAxisd(hp.yaw_rad, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(hp.pitch_rad, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(hp.roll_rad, Eigen::Vector3d::UnitY()))
+            .toRotationMatrix();
+    const Eigen::Vector3d light = Eigen::Vector3d(0.3, -0.4, 1.0).normalized();
+    std::vector<double> depth = bg_depth_;
+    std::vector<Eigen::Vector3f> colour = bg_colour_;
+    // Only pixels inside the projection of the hand's bounding sphere can see the hand.
+    const Eigen::Vector3d c_C = R_P_C_.transpose() * (hand_c - eye_);
+    const double radius = kHandSemiAxes.maxCoeff();
+    int u0 = 0, u1 = w - 1, v0 = 0, v1 = h - 1;
+    if (c_C.z() > radius) {
+      const double uc = K_(0, 0) * c_C.x() / c_C.z() + K_(0, 2);
+      const double vc = K_(1, 1) * c_C.y() / c_C.z() + K_(1, 2);
+      const double rp = K_(0, 0) * radius / (c_C.z() - radius) + 2.0;
+      u0 = std::max(0, static_cast<int>(uc - rp));
+      u1 = std::min(w - 1, static_cast<int>(uc + rp));
+      v0 = std::max(0, static_cast<int>(vc - rp));
+      v1 = std::min(h - 1, static_cast<int>(vc + rp));
+    }
+    const Eigen::Vector3d o = (R_P_H.transpose() * (eye_ - hand_c)).cwiseQuotient(kHandSemiAxes);
+    for (int v = v0; v <= v1; ++v) {
+      for (int u = u0; u <= u1; ++u) {
         // Hand ellipsoid: unit sphere in scaled hand coordinates.
-        const Eigen::Vector3d o = (R_P_H.transpose() * (eye_ - hand_c)).cwiseQuotient(kHandSemiAxes);
-        const Eigen::Vector3d dd = (R_P_H.transpose() * d).cwiseQuotient(kHandSemiAxes);
+        const Eigen::Vector3d dd = (R_P_H.transpose() * Ray(u, v)).cwiseQuotient(kHandSemiAxes);
         const double A = dd.squaredNorm(), B = 2 * o.dot(dd), C = o.squaredNorm() - 1.0;
         const double disc = B * B - 4 * A * C;
-        if (disc > 0) {
-          const double t = (-B - std::sqrt(disc)) / (2 * A);
-          if (t > 0 && t < best) {
-            best = t;
-            const Eigen::Vector3d ls = o + t * dd;  // unit sphere point
-            const Eigen::Vector3d lp = ls.cwiseProduct(kHandSemiAxes);
-            const Eigen::Vector3d n_P = R_P_H * ls.cwiseQuotient(kHandSemiAxes).normalized();
-            const double lambert = 0.55 + 0.45 * std::max(0.0, n_P.dot(light));
-            // Texture fixed to the hand (skin folds, nails, the tool): flow follows rotations.
-            const double tex = 0.55 * ValueNoise(lp.x() + lp.z(), lp.y() - lp.z(), 0.012, 21) +
-                               0.45 * ValueNoise(lp.x() - lp.z(), lp.y() + 0.5 * lp.z(), 0.006, 22);
-            rgb = Eigen::Vector3d(0.85, 0.62, 0.5) * lambert * (0.55 + 0.45 * tex);
-          }
-        }
-        if (best < kInf && best < 6.0) {
-          depth[static_cast<std::size_t>(v) * w + u] = best;
-          colour[static_cast<std::size_t>(v) * w + u] = rgb;
-        }
+        if (disc <= 0) continue;
+        const double t = (-B - std::sqrt(disc)) / (2 * A);
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        if (!(t > 0) || (depth[i] > 0 && t >= depth[i])) continue;
+        const Eigen::Vector3d ls = o + t * dd;  // unit sphere point
+        const Eigen::Vector3d lp = ls.cwiseProduct(kHandSemiAxes);
+        const Eigen::Vector3d n_P = R_P_H * ls.cwiseQuotient(kHandSemiAxes).normalized();
+        const double lambert = 0.55 + 0.45 * std::max(0.0, n_P.dot(light));
+        // Texture fixed to the hand (skin folds, nails, the tool): flow follows rotations.
+        const double tex = 0.55 * ValueNoise(lp.x() + lp.z(), lp.y() - lp.z(), 0.012, 21) +
+                           0.45 * ValueNoise(lp.x() - lp.z(), lp.y() + 0.5 * lp.z(), 0.006, 22);
+        depth[i] = t;
+        colour[i] = (Eigen::Vector3d(0.85, 0.62, 0.5) * lambert * (0.55 + 0.45 * tex)).cast<float>();
       }
     }
 
@@ -246,24 +278,36 @@ class SimManipScene::Impl {
     frame.stamp_ns = static_cast<std::int64_t>(std::llround(k * 1e9 / opt_.fps));
     frame.sequence = static_cast<std::uint64_t>(k);
     std::mt19937_64 rng(salt_ ^ (0xD1B54A32D192ED03ull * (k + 1)));
-    std::normal_distribution<double> gauss(0.0, 1.0);
-    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    const std::size_t table = noise_.size();
+    std::size_t at = rng() % table;
+    const std::size_t step = 1 + 2 * (rng() % 1000);  // odd: walks the whole table
+    auto next_noise = [&] {
+      at = (at + step) % table;
+      return noise_[at];
+    };
+    // Holes: ~1% random dropouts (a cheap hash per pixel and frame).
+    const std::uint64_t hole_salt = rng();
     for (int v = 0; v < h; ++v) {
       auto* drow = reinterpret_cast<std::uint16_t*>(frame.depth.row(v));
       std::uint8_t* crow = frame.rgb.row(v);
       for (int u = 0; u < w; ++u) {
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
         double z = depth[i];
-        if (z > 0 && opt_.noise) {
-          // Holes: random dropouts, and the IR shadow right of a near-to-far depth edge.
-          const bool shadow = u >= 1 && depth[i - 1] > 0 && depth[i - 1] < z - 0.05;
-          const bool shadow2 = u >= 2 && depth[i - 2] > 0 && depth[i - 2] < z - 0.05;
-          if (uni(rng) < 0.01 || (shadow && uni(rng) < 0.8) || (shadow2 && uni(rng) < 0.4)) z = 0;
-          else z += KinectSigmaM(z) * gauss(rng);
+        float cn = 0.f;
+        if (opt_.noise) {
+          cn = 2.0f * next_noise();
+          if (z > 0) {
+            // The IR shadow right of a near-to-far depth edge, and random dropouts.
+            const bool shadow = u >= 1 && depth[i - 1] > 0 && depth[i - 1] < z - 0.05;
+            const bool shadow2 = u >= 2 && depth[i - 2] > 0 && depth[i - 2] < z - 0.05;
+            const double r = Hash(u, v, hole_salt);
+            if (r < 0.01 || (shadow && r < 0.8) || (shadow2 && r < 0.4)) z = 0;
+            else z += KinectSigmaM(z) * next_noise();
+          }
         }
         drow[u] = z > 0 ? static_cast<std::uint16_t>(std::clamp(std::lround(z * 1000.0), 0L, 65535L)) : 0;
         for (int c = 0; c < 3; ++c) {
-          double val = colour[i][c] * 255.0 + (opt_.noise ? 2.0 * gauss(rng) : 0.0);
+          const double val = colour[i][c] * 255.0 + cn;
           crow[3 * u + c] = static_cast<std::uint8_t>(std::clamp(std::lround(val), 0L, 255L));
         }
       }
@@ -281,6 +325,9 @@ class SimManipScene::Impl {
   std::vector<Box> boxes_;
   SimManipTruth truth_;
   drivers::Calibration calibration_;
+  std::vector<double> bg_depth_;
+  std::vector<Eigen::Vector3f> bg_colour_;
+  std::vector<float> noise_;
 };
 
 SimManipScene::SimManipScene(const SimManipOptions& options) : impl_(std::make_unique<Impl>(options)) {}

@@ -32,7 +32,7 @@ struct ActionFeatures {
   double peak_height_m = 0.0;  ///< median r at prominent peaks
   double descent_speed_mps = 0.0;  ///< 95th percentile of the downward r speed
   double peak_inflection_fraction = 0.0;  ///< share of high peaks with a slow segment on a flank
-  double rotation_spread_z_deg = 0.0;  ///< std of the cumulative angle about the plane normal
+  double rotation_spread_z_deg = 0.0;  ///< std of the per-step angle about the plane normal (deg)
   double rotation_spread_xy_deg = 0.0;  ///< same about the in-plane axes (larger of the two)
 
   std::vector<std::pair<std::string, double>> Named() const;
@@ -45,19 +45,25 @@ ActionFeatures ComputeActionFeatures(const MotionProfiles& profiles,
 /// Decision thresholds, chosen on sim-manip seeds 0-9 (`romo eval manip --seeds 0-9
 /// --features`) and tested on disjoint seeds.
 struct ActionThresholds {
-  double tightening_rotation_deg = 12.0;
+  /// Tightening: wrist turns (per-step rotation spread, deg) with only short translations (m)
+  /// and no strokes towards the plane (spikes per second).
+  double tightening_rotation_deg = 1.5;
+  double tightening_max_xy_range_m = 0.032;
+  double tightening_max_spike_rate_hz = 0.5;
+  /// Peaks higher than this lift the hand far off the plane (hammer, fork, glass).
   double high_peak_m = 0.19;
-  double hitting_descent_mps = 0.9;
+  double hitting_descent_mps = 1.0;
   double drinking_peak_m = 0.29;
   double drinking_inflection_fraction = 0.5;
-  double sawtooth = 0.9;
-  double sawtooth_periodicity = 0.25;
-  double board_row_length_m = 0.3;
-  double poking_spike_rate_hz = 0.6;
-  double poking_max_xy_range_m = 0.08;
-  double pulling_periodicity = 0.5;
-  double pulling_min_period_s = 1.1;
-  double chopping_periodicity = 0.4;
+  /// Writing: a skewed row velocity (sawtooth) that repeats; board rows are longer than pen rows.
+  double sawtooth = 1.4;
+  double sawtooth_periodicity = 0.5;
+  double board_row_length_m = 0.27;
+  /// Strokes towards the plane: spikes per second; irregular ones poke, regular ones chop.
+  double stroke_spike_rate_hz = 1.0;
+  double regular_periodicity = 0.85;
+  /// Pulling: a regular rocking of the distance to the plane with this span at least (m).
+  double pulling_min_r_range_m = 0.04;
   void Validate() const;
 };
 
