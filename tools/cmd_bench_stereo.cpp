@@ -115,7 +115,7 @@ void Run(const Options& o) {
       ratios.emplace_back(std::string(mode_name) + " " + std::to_string(threads) + "T", romo_ms / ocv_ms);
     }
     stereo::StereoSgm defaults(o.width, o.height, o.ndisp, 8, 16);
-    rows.push_back({"romo defaults (3 paths, block 1, median)", threads,
+    rows.push_back({"romo defaults (3 paths, block 1)", threads,
                     MedianMs([&] { defaults.execute(left, right, &out); }, o.repeat)});
     progress.Update(++done);
   }

@@ -24,10 +24,11 @@ enum class PostFilter {
 
 /// Matching parameters. Costs are sums over a block_size^2 window of pre-filtered intensities,
 /// so p1/p2 scale with block_size^2 (OpenCV's test uses 10 w^2 and 40 w^2).
-/// The defaults were tuned on the Middlebury scenes with `romo eval stereo` (3 paths, 1 px block,
-/// median on): they beat OpenCV's own reference figures on every scene (tests/stereo/
-/// middlebury_test.cpp). WLS was measured and does not pay off there (RMS doubles on poster and
-/// sawtooth); 8 paths were no better than 3 at 3-6x the cost.
+/// The defaults were tuned on the Middlebury scenes with `romo eval stereo` (3 paths, 1 px block):
+/// they beat OpenCV's own reference figures on every scene (tests/stereo/middlebury_test.cpp).
+/// Post-filters measured there: the valid-only 3x3 median lowers bad-1 by at most 0.0015 (tsukuba
+/// 0.0620 -> 0.0605) for ~25% more time, so it is off by default; WLS does not pay off (RMS
+/// doubles on poster and sawtooth). 8 paths were no better than 3 at 3-6x the cost.
 struct SgmParameters {
   int p1 = 14;  ///< penalty for a +-1 px disparity change between neighbours
   int p2 = 30;  ///< penalty for larger disparity jumps; must exceed p1
@@ -42,7 +43,7 @@ struct SgmParameters {
   int pre_filter_cap = 63;  ///< clamp of the x-derivative pre-filter, 1..63
   int speckle_window_px = 100;  ///< largest blob (px) removed as speckle; 0 = no speckle filter
   int speckle_range_px = 2;  ///< max disparity step (px) inside one speckle blob
-  PostFilter post_filter = PostFilter::kMedian3;
+  PostFilter post_filter = PostFilter::kNone;
   /// @throws romo::Error naming the field and value.
   void Validate() const;
 };
