@@ -1,0 +1,233 @@
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "romo/core/check.hpp"
+#include "romo/objects/box.hpp"
+
+namespace romo::objects {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+// Footprints whose sides differ by less than this fraction are "nearly square": their length
+// axis is ambiguous, so a hint's continuity beats the length >= width rule.
+constexpr float kNearSquareFraction = 0.1f;
+
+/// Wraps to [-pi, pi).
+float WrapPi(float a) { return a - 2.f * kPi * std::floor((a + kPi) / (2.f * kPi)); }
+/// Wraps to [-pi/2, pi/2).
+float WrapHalfPi(float a) { return a - kPi * std::floor((a + 0.5f * kPi) / kPi); }
+
+void CheckIndices(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const char* who) {
+  if (indices.empty()) {
+    std::ostringstream msg;
+    msg << who << ": no points (empty index list)";
+    Fail(msg.str());
+  }
+  for (int i : indices) {
+    if (i < 0 || i >= xyz.cols() || !xyz.col(i).allFinite()) {
+      std::ostringstream msg;
+      msg << who << ": point index " << i << (i < 0 || i >= xyz.cols() ? " out of range for " : " is non-finite in ")
+          << "a cloud of " << xyz.cols() << " points";
+      Fail(msg.str());
+    }
+  }
+}
+
+using Point2 = Eigen::Vector2f;
+
+float Cross(const Point2& o, const Point2& a, const Point2& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+/// Convex hull (Andrew's monotone chain), counter-clockwise, no collinear points.
+std::vector<Point2> ConvexHull(std::vector<Point2> pts) {
+  std::sort(pts.begin(), pts.end(), [](const Point2& a, const Point2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  std::vector<Point2> hull(2 * pts.size());
+  std::size_t k = 0;
+  for (const auto& p : pts) {
+    while (k >= 2 && Cross(hull[k - 2], hull[k - 1], p) <= 0.f) --k;
+    hull[k++] = p;
+  }
+  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && Cross(hull[k - 2], hull[k - 1], pts[i]) <= 0.f) --k;
+    hull[k++] = pts[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+}  // namespace
+
+bool Box3::Contains(const Eigen::Vector3f& p, float margin_m) const {
+  const Eigen::Vector3f local = axes.transpose() * (p - center);
+  return (local.cwiseAbs().array() <= (0.5f * size.array() + margin_m)).all();
+}
+
+Eigen::Matrix<float, 3, 8> Box3::Corners() const {
+  Eigen::Matrix<float, 3, 8> c;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3f s((k & 1) ? 0.5f : -0.5f, (k & 2) ? 0.5f : -0.5f, (k & 4) ? 0.5f : -0.5f);
+    c.col(k) = center + axes * s.cwiseProduct(size);
+  }
+  return c;
+}
+
+float CanonicalYaw(float yaw_rad, float* length_m, float* width_m, std::optional<float> hint_yaw_rad) {
+  ROMO_THROW_UNLESS(length_m != nullptr && width_m != nullptr);
+  if (!std::isfinite(yaw_rad)) Fail("CanonicalYaw: yaw_rad is not finite");
+  float l = *length_m, w = *width_m;
+  if (!hint_yaw_rad) {
+    if (l < w) {
+      std::swap(l, w);
+      yaw_rad += 0.5f * kPi;
+    }
+    *length_m = l;
+    *width_m = w;
+    return WrapHalfPi(yaw_rad);
+  }
+  if (!std::isfinite(*hint_yaw_rad)) Fail("CanonicalYaw: hint_yaw_rad is not finite");
+  const bool near_square = std::abs(l - w) < kNearSquareFraction * std::max(l, w);
+  float best_yaw = 0.f, best_l = l, best_w = w, best_err = 1e9f;
+  for (int k = 0; k < 4; ++k) {
+    const bool swapped = (k % 2) == 1;
+    const float cl = swapped ? w : l, cw = swapped ? l : w;
+    if (!near_square && cl < cw) continue;
+    const float cand = yaw_rad + static_cast<float>(k) * 0.5f * kPi;
+    const float err = std::abs(WrapPi(cand - *hint_yaw_rad));
+    if (err < best_err) {
+      best_err = err;
+      best_yaw = *hint_yaw_rad + WrapPi(cand - *hint_yaw_rad);
+      best_l = cl;
+      best_w = cw;
+    }
+  }
+  *length_m = best_l;
+  *width_m = best_w;
+  return WrapPi(best_yaw);
+}
+
+Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
+  CheckIndices(xyz, indices, "FitPcaBox");
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : indices) mean += xyz.col(i).cast<double>();
+  mean /= static_cast<double>(indices.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i : indices) {
+    const Eigen::Vector3d q = xyz.col(i).cast<double>() - mean;
+    cov.noalias() += q * q.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  Eigen::Matrix3f axes;
+  axes.col(0) = eig.eigenvectors().col(2).cast<float>().normalized();  // largest variance
+  axes.col(1) = eig.eigenvectors().col(1).cast<float>().normalized();
+  axes.col(2) = axes.col(0).cross(axes.col(1)).normalized();
+  if (axes(2, 2) < 0.f) {  // third axis up; flipping two columns keeps the rotation proper
+    axes.col(2) = -axes.col(2);
+    axes.col(1) = -axes.col(1);
+  }
+  const Eigen::Vector3f m = mean.cast<float>();
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
+  for (int i : indices) {
+    const Eigen::Vector3f local = axes.transpose() * (xyz.col(i) - m);
+    lo = lo.cwiseMin(local);
+    hi = hi.cwiseMax(local);
+  }
+  Box3 box;
+  box.size = hi - lo;
+  box.center = m + axes * (0.5f * (hi + lo));
+  if (box.size.x() < box.size.y()) {  // length first: rotate 90 deg about col(2)
+    const Eigen::Vector3f c0 = axes.col(0);
+    axes.col(0) = axes.col(1);
+    axes.col(1) = -c0;
+    std::swap(box.size.x(), box.size.y());
+  }
+  float yaw = std::atan2(axes(1, 0), axes(0, 0));
+  if (yaw < -0.5f * kPi || yaw >= 0.5f * kPi) {
+    // Heading outside [-pi/2, pi/2): turn the box 180 deg about col(2) (same box, other name).
+    axes.col(0) = -axes.col(0);
+    axes.col(1) = -axes.col(1);
+    yaw = std::atan2(axes(1, 0), axes(0, 0));
+  }
+  box.axes = axes;
+  box.yaw_rad = yaw;
+  return box;
+}
+
+Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
+                    std::optional<float> hint_yaw_rad) {
+  CheckIndices(xyz, indices, "FitVerticalBox");
+  if (!(up.allFinite() && std::abs(up.norm() - 1.f) < 1e-3f)) {
+    std::ostringstream msg;
+    msg << "FitVerticalBox: up must be a unit vector, got (" << up.transpose() << ")";
+    Fail(msg.str());
+  }
+  // Ground-plane basis: the frame's x (or y when x is nearly vertical) projected onto the plane.
+  Eigen::Vector3f e1 = Eigen::Vector3f::UnitX() - up.x() * up;
+  if (e1.norm() < 0.1f) e1 = Eigen::Vector3f::UnitY() - up.y() * up;
+  e1.normalize();
+  const Eigen::Vector3f e2 = up.cross(e1);
+
+  std::vector<Point2> footprint;
+  footprint.reserve(indices.size());
+  float h_lo = 1e30f, h_hi = -1e30f;
+  for (int i : indices) {
+    const Eigen::Vector3f p = xyz.col(i);
+    footprint.emplace_back(p.dot(e1), p.dot(e2));
+    h_lo = std::min(h_lo, p.dot(up));
+    h_hi = std::max(h_hi, p.dot(up));
+  }
+  const std::vector<Point2> hull = ConvexHull(std::move(footprint));
+
+  // Minimum-area rectangle: one side lies on a hull edge (rotating calipers, O(h^2) is plenty
+  // for the hull sizes of single objects).
+  float best_area = 1e30f, best_yaw = 0.f;
+  Point2 best_center = hull.front();
+  float best_l = 0.f, best_w = 0.f;
+  const std::size_t edges = hull.size() < 2 ? 1 : hull.size();
+  for (std::size_t e = 0; e < edges; ++e) {
+    float angle = 0.f;
+    if (hull.size() >= 2) {
+      const Point2 d = hull[(e + 1) % hull.size()] - hull[e];
+      angle = std::atan2(d.y(), d.x());
+    }
+    const float c = std::cos(angle), s = std::sin(angle);
+    float a_lo = 1e30f, a_hi = -1e30f, b_lo = 1e30f, b_hi = -1e30f;
+    for (const auto& p : hull) {
+      const float a = c * p.x() + s * p.y(), b = -s * p.x() + c * p.y();
+      a_lo = std::min(a_lo, a);
+      a_hi = std::max(a_hi, a);
+      b_lo = std::min(b_lo, b);
+      b_hi = std::max(b_hi, b);
+    }
+    const float area = (a_hi - a_lo) * (b_hi - b_lo);
+    // Ties (and degenerate, zero-area footprints) keep the longest side as the heading.
+    if (area < best_area - 1e-9f || (std::abs(area - best_area) <= 1e-9f && a_hi - a_lo > best_l)) {
+      best_area = area;
+      best_yaw = angle;
+      best_l = a_hi - a_lo;
+      best_w = b_hi - b_lo;
+      const float am = 0.5f * (a_lo + a_hi), bm = 0.5f * (b_lo + b_hi);
+      best_center = Point2(c * am - s * bm, s * am + c * bm);
+    }
+  }
+  Box3 box;
+  float l = best_l, w = best_w;
+  box.yaw_rad = CanonicalYaw(best_yaw, &l, &w, hint_yaw_rad);
+  box.size = Eigen::Vector3f(l, w, h_hi - h_lo);
+  box.center = best_center.x() * e1 + best_center.y() * e2 + 0.5f * (h_lo + h_hi) * up;
+  const Eigen::Vector3f heading = std::cos(box.yaw_rad) * e1 + std::sin(box.yaw_rad) * e2;
+  box.axes.col(0) = heading;
+  box.axes.col(1) = up.cross(heading);
+  box.axes.col(2) = up;
+  return box;
+}
+
+}  // namespace romo::objects

@@ -1,0 +1,172 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "romo/core/check.hpp"
+#include "romo/mapping/segmentation.hpp"
+#include "romo/mapping/synthetic_scene.hpp"
+#include "romo/objects/box.hpp"
+
+namespace romo::objects {
+namespace {
+
+constexpr float kPi = 3.14159265f;
+// Surfaces sampled at 2000 points/m^2: extremes lie within ~1 cm of the true faces.
+constexpr float kCentreToleranceM = 0.03f;
+constexpr float kSizeToleranceM = 0.04f;
+constexpr float kYawToleranceRad = 0.02f;  // ~1 deg: hull edges of a densely sampled footprint
+
+float AngleDiffHalfTurn(float a, float b) {
+  // Boxes are symmetric under 180 deg turns.
+  float d = std::fmod(std::abs(a - b), kPi);
+  return std::min(d, kPi - d);
+}
+
+mapping::SyntheticScene Scene(std::vector<mapping::SceneObject> objects, float noise_m = 0.f) {
+  mapping::SyntheticSceneParams sp;
+  sp.density_per_m2 = 2000.f;
+  sp.noise_m = noise_m;
+  return mapping::MakeSyntheticScene(objects, sp);
+}
+
+std::vector<int> PointsOf(const mapping::SyntheticScene& s, int label) {
+  std::vector<int> idx;
+  for (std::size_t i = 0; i < s.labels.size(); ++i)
+    if (s.labels[i] == label) idx.push_back(static_cast<int>(i));
+  return idx;
+}
+
+TEST(BoxFitTest, VerticalBoxRecoversCarAndPedestrianPoses) {
+  mapping::SceneObject car;
+  car.center_xy = {6.f, -3.f};
+  car.size = {4.5f, 1.8f, 1.5f};
+  car.yaw_rad = 0.4f;
+  mapping::SceneObject ped;
+  ped.shape = mapping::SceneObject::Shape::kCylinder;
+  ped.center_xy = {-2.f, 4.f};
+  ped.size = {0.5f, 0.5f, 1.75f};
+  const auto scene = Scene({car, ped});
+  const Box3 b = FitVerticalBox(scene.cloud.xyz, PointsOf(scene, 0));
+  EXPECT_LT((b.center - Eigen::Vector3f(6.f, -3.f, 0.75f)).norm(), kCentreToleranceM);
+  EXPECT_NEAR(b.size.x(), 4.5f, kSizeToleranceM);
+  EXPECT_NEAR(b.size.y(), 1.8f, kSizeToleranceM);
+  EXPECT_NEAR(b.size.z(), 1.5f, kSizeToleranceM);
+  EXPECT_NEAR(b.yaw_rad, 0.4f, kYawToleranceRad);
+  EXPECT_NEAR(b.axes.determinant(), 1.f, 1e-5f);
+  const Box3 p = FitVerticalBox(scene.cloud.xyz, PointsOf(scene, 1));
+  EXPECT_LT((p.center - Eigen::Vector3f(-2.f, 4.f, 0.875f)).norm(), kCentreToleranceM);
+  // A circle's minimum-area square is its bounding square: 0.5 x 0.5.
+  EXPECT_NEAR(p.size.x(), 0.5f, kSizeToleranceM);
+  EXPECT_NEAR(p.size.y(), 0.5f, kSizeToleranceM);
+  EXPECT_NEAR(p.size.z(), 1.75f, kSizeToleranceM);
+}
+
+TEST(BoxFitTest, PartlySeenCarGivesTheTrueHeadingNotThePcaOne) {
+  // Only the rear and one side of a car are visible (an L in top view): PCA of those points is
+  // biased, the minimum-area rectangle is not.
+  mapping::SceneObject car;
+  car.center_xy = {0.f, 0.f};
+  car.size = {4.5f, 1.8f, 1.5f};
+  car.yaw_rad = -0.7f;
+  const auto scene = Scene({car});
+  const Eigen::Vector2f heading(std::cos(car.yaw_rad), std::sin(car.yaw_rad));
+  const Eigen::Vector2f left(-heading.y(), heading.x());
+  std::vector<int> seen;
+  for (int i : PointsOf(scene, 0)) {
+    const Eigen::Vector2f xy = scene.cloud.xyz.col(i).head<2>();
+    const float a = xy.dot(heading), s = xy.dot(left);
+    if (a < -2.24f || s > 0.89f) seen.push_back(i);  // rear face and left side
+  }
+  const Box3 b = FitVerticalBox(scene.cloud.xyz, seen);
+  EXPECT_NEAR(b.yaw_rad, -0.7f, kYawToleranceRad);
+  EXPECT_NEAR(b.size.x(), 4.5f, kSizeToleranceM);
+  EXPECT_NEAR(b.size.y(), 1.8f, kSizeToleranceM);
+}
+
+TEST(BoxFitTest, PcaBoxRecoversATiltedBox) {
+  // A box tilted 20 deg about x: the full 3D PCA box follows it (Fig. 3.9).
+  mapping::SceneObject crate;
+  crate.size = {2.f, 1.f, 0.5f};
+  crate.yaw_rad = 0.3f;
+  auto scene = Scene({crate});
+  Eigen::Isometry3f tilt = Eigen::Isometry3f::Identity();
+  tilt.linear() = Eigen::AngleAxisf(0.35f, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  scene.cloud.Transform(tilt);
+  const Box3 b = FitPcaBox(scene.cloud.xyz, PointsOf(scene, 0));
+  // No bottom face is sampled, so the centre is estimated from the extremes, not the mean.
+  EXPECT_LT((b.center - tilt * Eigen::Vector3f(0.f, 0.f, 0.25f)).norm(), kCentreToleranceM);
+  EXPECT_NEAR(b.size.x(), 2.f, kSizeToleranceM);
+  EXPECT_NEAR(b.size.y(), 1.f, kSizeToleranceM);
+  EXPECT_NEAR(b.size.z(), 0.5f, kSizeToleranceM);
+  const Eigen::Vector3f true_length_axis = tilt.linear() * Eigen::Vector3f(std::cos(0.3f), std::sin(0.3f), 0.f);
+  EXPECT_GT(std::abs(b.axes.col(0).dot(true_length_axis)), std::cos(kYawToleranceRad * 2));
+  EXPECT_GT(b.axes(2, 2), 0.f);
+  EXPECT_GE(b.yaw_rad, -kPi / 2);
+  EXPECT_LT(b.yaw_rad, kPi / 2);
+  for (int i : PointsOf(scene, 0)) EXPECT_TRUE(b.Contains(scene.cloud.xyz.col(i), 1e-4f));
+}
+
+TEST(BoxFitTest, HeadingIsStableAcrossFramesWithoutFlips) {
+  // The same car re-sampled 30 times (new noise each frame) at headings near the +-pi/2 seam and
+  // near 0: yaw stays in [-pi/2, pi/2), length >= width, and never jumps by 90 or 180 deg.
+  for (float yaw : {0.f, 1.5707f, -1.5707f, 3.1f}) {
+    float previous = 0.f;
+    for (int frame = 0; frame < 30; ++frame) {
+      mapping::SceneObject car;
+      car.size = {4.5f, 1.8f, 1.5f};
+      car.yaw_rad = yaw;
+      mapping::SyntheticSceneParams sp;
+      sp.density_per_m2 = 800.f;
+      sp.noise_m = 0.01f;
+      sp.seed = 100 + frame;
+      const auto scene = mapping::MakeSyntheticScene({car}, sp);
+      const Box3 b = FitVerticalBox(scene.cloud.xyz, PointsOf(scene, 0));
+      EXPECT_GE(b.size.x(), b.size.y());
+      EXPECT_GE(b.yaw_rad, -kPi / 2);
+      EXPECT_LT(b.yaw_rad, kPi / 2);
+      EXPECT_LT(AngleDiffHalfTurn(b.yaw_rad, yaw), 0.03f);
+      // With the previous frame's yaw as hint, the heading is continuous (no wrap at the seam).
+      const Box3 h = FitVerticalBox(scene.cloud.xyz, PointsOf(scene, 0), Eigen::Vector3f::UnitZ(),
+                                    frame == 0 ? std::optional<float>(yaw) : std::optional<float>(previous));
+      EXPECT_LT(std::abs(std::remainder(h.yaw_rad - yaw, 2.f * kPi)), 0.03f) << "yaw " << yaw << " frame " << frame;
+      previous = h.yaw_rad;
+    }
+  }
+}
+
+TEST(BoxFitTest, CanonicalYawRules) {
+  float l = 1.f, w = 3.f;
+  EXPECT_NEAR(CanonicalYaw(0.2f, &l, &w), 0.2f + kPi / 2 - kPi, 1e-6f);
+  EXPECT_EQ(l, 3.f);
+  EXPECT_EQ(w, 1.f);
+  l = 3.f;
+  w = 1.f;
+  EXPECT_NEAR(CanonicalYaw(kPi / 2, &l, &w), -kPi / 2, 1e-6f);  // half-open range
+  // Hint near pi: the equivalent heading near pi, not its wrapped twin.
+  l = 3.f;
+  w = 1.f;
+  EXPECT_NEAR(std::abs(CanonicalYaw(0.05f, &l, &w, 3.1f)), kPi - 0.05f, 1e-5f);
+  // Nearly square: continuity with the hint beats length >= width.
+  l = 1.0f;
+  w = 1.05f;
+  EXPECT_NEAR(CanonicalYaw(0.f, &l, &w, 0.02f), 0.f, 1e-6f);
+  EXPECT_EQ(l, 1.0f);
+}
+
+TEST(BoxFitTest, BadInputIsRejected) {
+  Eigen::Matrix3Xf xyz(3, 2);
+  xyz.col(0) = Eigen::Vector3f(1, 2, 3);
+  xyz.col(1) = Eigen::Vector3f(std::nanf(""), 0, 0);
+  EXPECT_THROW(FitPcaBox(xyz, {}), romo::Error);
+  EXPECT_THROW(FitVerticalBox(xyz, {}), romo::Error);
+  EXPECT_THROW(FitVerticalBox(xyz, {1}), romo::Error);
+  EXPECT_THROW(FitVerticalBox(xyz, {2}), romo::Error);
+  EXPECT_THROW(FitVerticalBox(xyz, {0}, Eigen::Vector3f(0, 0, 2)), romo::Error);
+  const Box3 single = FitVerticalBox(xyz, {0});  // a single point: a zero-size box at it
+  EXPECT_TRUE(single.center.isApprox(Eigen::Vector3f(1, 2, 3)));
+  EXPECT_EQ(single.size, Eigen::Vector3f::Zero());
+}
+
+}  // namespace
+}  // namespace romo::objects
