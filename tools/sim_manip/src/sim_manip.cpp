@@ -123,11 +123,11 @@ class SimManipScene::Impl {
 
     // Objects on the plane, away from the hand's working area.
     if (board_) {
-      boxes_.push_back({{-0.35, -0.55, 0.0}, {0.6, -0.5, 0.06}, {0.55, 0.55, 0.6}});  // marker tray
-      boxes_.push_back({{-0.3, 0.15, 0.0}, {-0.22, 0.23, 0.02}, {0.8, 0.2, 0.2}});   // magnet
+      boxes_.push_back({{-0.35, -0.85, 0.0}, {0.6, -0.8, 0.06}, {0.55, 0.55, 0.6}});  // marker tray
+      boxes_.push_back({{-0.35, 0.15, 0.0}, {-0.27, 0.23, 0.02}, {0.8, 0.2, 0.2}});   // magnet
     } else {
-      boxes_.push_back({{-0.32, 0.12, 0.0}, {-0.24, 0.2, 0.12}, {0.2, 0.35, 0.8}});  // cup
-      boxes_.push_back({{0.22, -0.2, 0.0}, {0.37, -0.1, 0.04}, {0.3, 0.7, 0.3}});   // box
+      boxes_.push_back({{-0.42, 0.15, 0.0}, {-0.34, 0.23, 0.12}, {0.2, 0.35, 0.8}});  // cup
+      boxes_.push_back({{0.3, 0.25, 0.0}, {0.45, 0.35, 0.04}, {0.3, 0.7, 0.3}});     // box
     }
 
     // Truth in the camera frame.
