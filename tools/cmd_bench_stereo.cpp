@@ -27,22 +27,45 @@ namespace romo::tools {
 namespace {
 
 struct Options {
-  int width = 782, height = 582, ndisp = 128, repeat = 5, block = 5;
+  int width = 782, height = 582, ndisp = 128, repeat = 7, block = 5;
   std::string kitti_dir;  // use a real KITTI pair resized instead of the synthetic one
   std::string calib;
   bool json = false;
 };
 
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+double TimeMs(const std::function<void()>& run) {
+  const auto t0 = std::chrono::steady_clock::now();
+  run();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 double MedianMs(const std::function<void()>& run, int repeat) {
   run();  // warm-up: allocations, caches
   std::vector<double> ms;
+  for (int i = 0; i < repeat; ++i) ms.push_back(TimeMs(run));
+  return Median(ms);
+}
+
+// Baseline and candidate run alternately so load changes on a shared machine hit both alike; the
+// ratio is the median of the per-round ratios.
+struct Paired {
+  double base_ms, candidate_ms, ratio;
+};
+Paired MeasurePaired(const std::function<void()>& base, const std::function<void()>& candidate, int repeat) {
+  base();
+  candidate();
+  std::vector<double> b, c, r;
   for (int i = 0; i < repeat; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    run();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    b.push_back(TimeMs(base));
+    c.push_back(TimeMs(candidate));
+    r.push_back(c.back() / b.back());
   }
-  std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
-  return ms[ms.size() / 2];
+  return {Median(b), Median(c), Median(r)};
 }
 
 struct Row {
@@ -106,13 +129,13 @@ void Run(const Options& o) {
       stereo::SgmParameters p = same;
       p.path_count = paths;
       stereo::StereoSgm romo(o.width, o.height, o.ndisp, 8, 16, p);
-      const double ocv_ms = MedianMs([&] { ocv->compute(left, right, out); }, o.repeat);
-      progress.Update(++done);
-      const double romo_ms = MedianMs([&] { romo.execute(left, right, &out); }, o.repeat);
-      progress.Update(++done);
-      rows.push_back({std::string("opencv ") + mode_name, threads, ocv_ms});
-      rows.push_back({std::string("romo wrapper ") + mode_name, threads, romo_ms});
-      ratios.emplace_back(std::string(mode_name) + " " + std::to_string(threads) + "T", romo_ms / ocv_ms);
+      const Paired m = MeasurePaired([&] { ocv->compute(left, right, out); },
+                                     [&] { romo.execute(left, right, &out); }, o.repeat);
+      done += 2;
+      progress.Update(done);
+      rows.push_back({std::string("opencv ") + mode_name, threads, m.base_ms});
+      rows.push_back({std::string("romo wrapper ") + mode_name, threads, m.candidate_ms});
+      ratios.emplace_back(std::string(mode_name) + " " + std::to_string(threads) + "T", m.ratio);
     }
     stereo::StereoSgm defaults(o.width, o.height, o.ndisp, 8, 16);
     rows.push_back({"romo defaults (3 paths, block 1)", threads,
@@ -178,7 +201,7 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--height", opts->height, "image height")->capture_default_str();
   cmd->add_option("--ndisp", opts->ndisp, "disparities (multiple of 16)")->capture_default_str();
   cmd->add_option("--block", opts->block, "block size for the OpenCV-vs-wrapper rows")->capture_default_str();
-  cmd->add_option("--repeat", opts->repeat, "timed runs per row (median reported)")->capture_default_str();
+  cmd->add_option("--repeat", opts->repeat, "timed runs per row (medians reported; OpenCV and romo alternate)")->capture_default_str();
   cmd->add_option("--kitti", opts->kitti_dir, "folder with a KITTI left.png/right.png to resize instead");
   cmd->add_option("--calib", opts->calib, "calibration for the 6-rig row (default: the sample)");
   cmd->add_flag("--json", opts->json, "print one JSON object");

@@ -118,7 +118,7 @@ class StereoSgm::Impl {
       case PostFilter::kWls: {
         right_matcher_->compute(r, l, right_raw_);
         wls_->filter(raw, l, filtered_, right_raw_);
-        // WLS leaves the unmatched left band at its own fill value; keep OpenCV's invalid code.
+        // WLS output (same 1/16 px scale) replaces the raw map; it fills most invalid pixels.
         filtered_.copyTo(raw);
         break;
       }
