@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <set>
 #include <sstream>
+#include <dlfcn.h>
 #include <sys/stat.h>
 
 #include <opencv2/core.hpp>
@@ -338,12 +339,25 @@ void Calibration::Save(const std::string& path) const {
 
 std::string SampleCalibrationPath() {
   const std::string relative = "/calibration/romo_sample.yaml";
-  for (const std::string& dir : {std::string(ROMO_SOURCE_CONFIG_DIR),
-                                std::string(ROMO_INSTALL_CONFIG_DIR)}) {
-    if (FileExists(dir + relative)) return dir + relative;
+  std::vector<std::string> dirs;
+  // An installed library finds the data installed beside it, wherever the prefix was moved.
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<void*>(&SampleCalibrationPath), &info) != 0 &&
+      info.dli_fname != nullptr) {
+    const std::string library = info.dli_fname;
+    const auto slash = library.rfind('/');
+    if (slash != std::string::npos) {
+      dirs.push_back(library.substr(0, slash) + "/" + ROMO_CONFIG_DIR_FROM_LIBDIR);
+    }
   }
-  Fail(std::string("sample calibration not found in ") + ROMO_SOURCE_CONFIG_DIR + " or " +
-       ROMO_INSTALL_CONFIG_DIR);
+  dirs.push_back(ROMO_SOURCE_CONFIG_DIR);
+  dirs.push_back(ROMO_INSTALL_CONFIG_DIR);
+  std::string tried;
+  for (const std::string& dir : dirs) {
+    if (FileExists(dir + relative)) return dir + relative;
+    tried += (tried.empty() ? "" : ", ") + dir;
+  }
+  Fail("sample calibration" + relative + " not found in " + tried);
 }
 
 }  // namespace romo::drivers

@@ -80,20 +80,34 @@ void RegisterLcmType(std::int64_t fingerprint, const std::string& type_name) {
   registry.names[fingerprint] = type_name;
 }
 
-std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* truncated_at) {
+std::int64_t ScanEvents(const std::string& path,
+                        const std::function<void(const LogEvent&)>& visit) {
   EventFileReader reader(path);
-  std::vector<LogEvent> events;
   LogEvent event;
   for (;;) {
     const ReadResult result = reader.Next(&event);
     if (result == ReadResult::kEvent) {
-      events.push_back(std::move(event));
+      visit(event);
       continue;
     }
     if (result == ReadResult::kCorrupt && reader.offset() == 0) NotALog(path);
-    if (truncated_at != nullptr) *truncated_at = result == ReadResult::kEnd ? -1 : reader.offset();
-    return events;
+    return result == ReadResult::kEnd ? -1 : reader.offset();
   }
+}
+
+std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* truncated_at) {
+  std::vector<LogEvent> events;
+  const std::int64_t cut = ScanEvents(path, [&](const LogEvent& event) { events.push_back(event); });
+  if (truncated_at != nullptr) *truncated_at = cut;
+  return events;
+}
+
+std::optional<std::uint64_t> FrameSequenceOf(const LogEvent& event) {
+  // Every part type starts with fingerprint (8 bytes), stamp_ns, frame_sequence (big-endian).
+  if (!IsFramePartChannel(event.channel) || event.data.size() < 24) return std::nullopt;
+  std::uint64_t value = 0;
+  for (std::size_t i = 16; i < 24; ++i) value = (value << 8) | event.data[i];
+  return value;
 }
 
 class LogReader::Impl {
@@ -171,14 +185,6 @@ class LogReader::Impl {
     return true;
   }
 
-  // Decodes only the frame_sequence of a part (all part types start with stamp_ns, frame_sequence).
-  static std::optional<std::uint64_t> PartSequence(const LogEvent& event) {
-    if (event.data.size() < 8 + 16) return std::nullopt;
-    std::uint64_t value = 0;
-    for (int i = 16; i < 24; ++i) value = (value << 8) | event.data[static_cast<std::size_t>(i)];
-    return value;
-  }
-
   std::optional<FrameSet> Next() {
     other_events_.clear();
     for (int attempt = 0; attempt < 2; ++attempt) {
@@ -208,7 +214,7 @@ class LogReader::Impl {
         other_events_.push_back(std::move(*event));
         continue;
       }
-      const std::optional<std::uint64_t> sequence = PartSequence(*event);
+      const std::optional<std::uint64_t> sequence = FrameSequenceOf(*event);
       if (started && sequence && *sequence != set_sequence) {
         pending_ = std::move(event);  // first part of the next set
         break;

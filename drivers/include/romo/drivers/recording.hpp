@@ -8,6 +8,7 @@
 /// Other channels (ground truth, outputs) pass through untouched as raw events.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -110,5 +111,14 @@ class LogReader : public FrameSource {
 /// Reads every complete event of a log (for `romo info`, tests); stops at a truncated tail.
 /// @param truncated_at set to the byte offset of the cut, or -1 when the file is complete.
 std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* truncated_at);
+
+/// Streams every complete event of a log to @p visit without holding them all in memory.
+/// @returns the byte offset where the file was cut or damaged, or -1 when it is complete.
+/// @throws romo::Error when the file is missing or not an LCM log.
+std::int64_t ScanEvents(const std::string& path, const std::function<void(const LogEvent&)>& visit);
+
+/// The frame_sequence carried by a frame-part event (stereo, RGB-D, vehicle state, GNSS), or
+/// nullopt for other channels or too-short data.
+std::optional<std::uint64_t> FrameSequenceOf(const LogEvent& event);
 
 }  // namespace romo::drivers

@@ -1,0 +1,40 @@
+# Installs the romo build into a scratch prefix, then configures, builds and runs the consumer
+# project against it with find_package(romo).
+# cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -P install_consumer.cmake
+foreach(var BUILD_DIR SOURCE_DIR WORK_DIR)
+  if(NOT ${var})
+    message(FATAL_ERROR "install_consumer.cmake: ${var} not set")
+  endif()
+endforeach()
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR}/run)
+
+function(step name)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${name} failed (${rc}):\n${out}\n${err}")
+  endif()
+  message(STATUS "${name}: ok")
+  set(step_output "${out}" PARENT_SCOPE)
+endfunction()
+
+step("install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+foreach(expected include/romo/drivers/recording.hpp include/romo/core/check.hpp
+                 share/romo/config/calibration/romo_sample.yaml)
+  if(NOT EXISTS ${WORK_DIR}/prefix/${expected})
+    message(FATAL_ERROR "install is missing ${expected}")
+  endif()
+endforeach()
+file(GLOB_RECURSE configs ${WORK_DIR}/prefix/*/romoConfig.cmake)
+if(NOT configs)
+  message(FATAL_ERROR "install has no romoConfig.cmake")
+endif()
+step("configure consumer" ${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/install/consumer -B ${WORK_DIR}/build
+     -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+step("build consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+step("run consumer" ${WORK_DIR}/build/romo_consumer ${WORK_DIR}/run)
+message(STATUS "${step_output}")
+if(NOT step_output MATCHES "romo consumer ok")
+  message(FATAL_ERROR "consumer output: ${step_output}")
+endif()
+file(REMOVE_RECURSE ${WORK_DIR})
