@@ -61,7 +61,7 @@ float Fbm(float x, float y, std::uint32_t seed, const float* wavelengths_m, cons
 
 float AsphaltAlbedo(float x, float y, std::uint32_t seed, float footprint_m) {
   static const float kWave[] = {0.012f, 0.025f, 0.05f, 0.11f, 0.27f, 0.7f, 2.1f};
-  static const float kAmp[] = {0.08f, 0.09f, 0.08f, 0.06f, 0.06f, 0.06f, 0.07f};
+  static const float kAmp[] = {0.08f, 0.09f, 0.09f, 0.08f, 0.08f, 0.07f, 0.07f};
   return Clamp01(0.32f + Fbm(x, y, seed, kWave, kAmp, 7, footprint_m));
 }
 
@@ -82,14 +82,17 @@ float CarAlbedo(const SurfacePoint& p, float base, std::uint32_t seed) {
   float a = base * (1.0f + 1.6f * Fbm(u, v, seed + static_cast<std::uint32_t>(p.face), kWave, kAmp, 5, p.footprint_m));
   const bool side = p.face == Face::kMinusY || p.face == Face::kPlusY;
   const bool end = p.face == Face::kMinusX || p.face == Face::kPlusX;
-  // Windows: a dark band below the roof, inset from the corners; glass reflects a little sky.
+  // Windows: a dark band below the roof, inset from the corners, with blurred reflections;
+  // wheels: dark rectangles low on the sides with tread and rim texture. Both keep enough
+  // contrast for stereo matching.
+  static const float kGlassWave[] = {0.025f, 0.06f, 0.15f, 0.4f};
+  static const float kGlassAmp[] = {0.07f, 0.08f, 0.08f, 0.08f};
   if ((side || end) && p.z > p.height - 0.55f && p.z < p.height - 0.1f) {
     const float inset = side ? std::abs(p.x) - (p.hl - 0.5f) : std::abs(p.y) - (p.hw - 0.2f);
-    if (inset < 0.0f) a = 0.12f + 0.5f * (a - base) + 0.06f * ValueNoise(u * 3.0f, v * 3.0f, seed);
+    if (inset < 0.0f) a = 0.16f + Fbm(u, v, seed ^ 0x6A55u, kGlassWave, kGlassAmp, 4, p.footprint_m);
   }
-  // Wheels: dark rectangles low on the sides.
   if (side && p.z < 0.62f && std::abs(std::abs(p.x) - (p.hl - 0.85f)) < 0.33f) {
-    a = 0.06f + 0.3f * (a - base);
+    a = 0.1f + 0.8f * Fbm(u, v, seed ^ 0x7EE1u, kGlassWave, kGlassAmp, 4, p.footprint_m);
   }
   // Lights on both ends.
   if (end && p.z > 0.55f && p.z < 0.75f && std::abs(p.y) > p.hw - 0.4f && std::abs(p.y) < p.hw - 0.08f) {

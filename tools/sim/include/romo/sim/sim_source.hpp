@@ -27,7 +27,7 @@ struct SimParams {
   bool distortion = true;              ///< [distortion=0|1] 0 renders (and reports) no distortion
   std::string calibration_path;        ///< [calib] default: the sample calibration
   std::int64_t start_stamp_ns = 1704067200000000000;  ///< [start_ns] 2024-01-01T00:00:00Z
-  RenderParams render;                 ///< [aa] samples per axis, [noise] sigma, [threads]
+  RenderParams render;  ///< [aa] samples per axis, [noise] sigma, [threads] (URI default: all cores)
 
   /// @throws romo::Error naming the field and value.
   void Validate() const;
