@@ -81,7 +81,7 @@ struct PerceptionStatus {
   std::vector<std::string> events;  ///< e.g. "rig 3 (rear) missing for 0.5 s"
 };
 
-/// One rig's cloud as a stereo worker publishes it (rig frame).
+/// One rig's cloud as a stereo worker publishes it (vehicle frame).
 struct RigCloud {
   std::int64_t stamp_ns = 0;
   std::int64_t frame_sequence = 0;

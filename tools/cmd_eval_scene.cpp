@@ -1,0 +1,35 @@
+// `romo eval scene --log OUT.lcmlog [--json]`: a run's outputs against the simulator's truth.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/command_registry.hpp"
+#include "romo/pipeline/scene_eval.hpp"
+
+namespace romo::tools {
+namespace {
+struct EvalSceneOptions {
+  std::string log;
+  bool json = false;
+  double range_m = 15.0;
+};
+}  // namespace
+
+ROMO_REGISTER_COMMAND([](CLI::App& root) {
+  auto opts = std::make_shared<EvalSceneOptions>();
+  CLI::App& eval = CommandGroup(root, "eval", "Score romo against references and ground truth");
+  CLI::App* cmd = eval.add_subcommand("scene", "Score a run's outputs log against the simulator's ground truth");
+  cmd->add_option("--log", opts->log, "outputs.lcmlog of `romo run` / `romo replay` of a simulated scene")->required();
+  cmd->add_flag("--json", opts->json, "print one JSON object");
+  cmd->add_option("--range", opts->range_m, "score objects within this range of the ego, m")->capture_default_str();
+  cmd->callback([opts] {
+    pipeline::SceneEvalParams p;
+    p.range_m = opts->range_m;
+    const pipeline::SceneEval e = pipeline::EvaluateSceneLog(opts->log, p);
+    std::printf("%s\n", opts->json ? e.ToJson().c_str() : e.ToText().c_str());
+  });
+});
+
+}  // namespace romo::tools

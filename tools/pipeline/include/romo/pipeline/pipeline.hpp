@@ -1,0 +1,120 @@
+#pragma once
+/// The vehicle pipeline for one frame set, as stages: stereo (per rig) -> 360 deg fusion ->
+/// ground removal -> segmentation -> boxes -> classes -> tracks -> pedestrian predictions ->
+/// parking slots -> outputs. Each stage calls its module; this library only chains them, keeps
+/// the state that lives across frames (tracker, slot filter, ENU origin) and times the stages.
+/// Used by `romo run`, `romo replay`, `romo fuse`, `romo stereo-worker` and `romo bench pipeline`.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "romo/core/point_cloud.hpp"
+#include "romo/drivers/calibration.hpp"
+#include "romo/drivers/frames.hpp"
+#include "romo/mapping/fusion.hpp"
+#include "romo/mapping/ground_removal.hpp"
+#include "romo/mapping/segmentation.hpp"
+#include "romo/objects/box.hpp"
+#include "romo/objects/prediction_log.hpp"
+#include "romo/objects/tracker.hpp"
+#include "romo/planning_iface/messages.hpp"
+#include "romo/planning_iface/parking_slot.hpp"
+
+namespace romo::pipeline {
+
+struct PipelineParams {
+  int threads = 2;                ///< rigs matched in parallel (stereo), 1..64
+  int disparity_size = 128;       ///< multiple of 16; 64 is enough at half resolution
+  double max_range_m = 20.0;      ///< stereo points farther away are dropped
+  mapping::FusionParams fusion;
+  mapping::GroundRemovalParams ground;
+  mapping::SegmentationParams segmentation = DefaultSegmentation();
+  /// Blobs whose box is lower than this are kerbs, lines and ground left-overs, not objects.
+  double min_object_height_m = 0.5;
+  objects::TrackerParams tracker;
+  objects::PredictorKind predictor = objects::PredictorKind::kRls;
+  planning_iface::ParkingParams parking;
+  std::string atlas_path;  ///< "" = objects::Atlas::DefaultPath()
+
+  static mapping::SegmentationParams DefaultSegmentation();
+  /// @throws romo::Error naming the field and value.
+  void Validate() const;
+};
+
+/// Wall time of one stage of one frame.
+using planning_iface::StageLatency;
+
+/// One rig's cloud entering fusion (from the in-process stereo stage or a stereo worker).
+struct RigInput {
+  int rig_id = 0;
+  std::int64_t stamp_ns = 0;
+  PointCloud cloud;  ///< vehicle frame (romo::stereo reprojects through T_vehicle_rig)
+  double stereo_ms = 0.0;
+};
+
+/// Everything one frame produced.
+struct FrameResult {
+  std::int64_t stamp_ns = 0;
+  std::int64_t frame_sequence = 0;
+  Eigen::Isometry3d T_world_vehicle = Eigen::Isometry3d::Identity();
+  planning_iface::Pose2 ego_world;
+  PointCloud cloud;                ///< fused, vehicle frame
+  mapping::Plane ground_plane;
+  bool ground_refined = false;
+  std::vector<int> ground_indices;
+  std::vector<std::vector<int>> blobs;          ///< into cloud
+  std::vector<objects::Box3> boxes;             ///< vehicle frame, one per kept blob
+  std::vector<std::string> box_classes;
+  std::vector<objects::Track> tracks;           ///< world frame
+  std::vector<objects::PedestrianPrediction> predictions;
+  planning_iface::ObstacleList obstacles;       ///< vehicle frame
+  planning_iface::ParkingSlotReport slots;      ///< world frame (+ ego pose)
+  planning_iface::PerceptionStatus status;
+  std::vector<int> missing_rigs;
+};
+
+class Pipeline {
+ public:
+  /// @throws romo::Error for invalid params, a calibration without rigs or an unreadable Atlas.
+  Pipeline(const drivers::Calibration& calibration, const PipelineParams& params);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  /// Stereo for every rig of @p frames, then ProcessClouds.
+  /// @throws romo::Error when a stereo frame does not match its calibration.
+  FrameResult Process(const drivers::FrameSet& frames);
+
+  /// Stereo only: the rig's cloud (what a stereo worker publishes); nullopt when the rig's
+  /// images could not be matched (counted as dropped, reported as an event).
+  std::optional<RigInput> Stereo(const drivers::StereoFrame& frame);
+
+  /// Everything after stereo. Rigs of the calibration absent from @p rigs are reported missing
+  /// (status event, rig not present) and the frame is processed without them.
+  /// @throws romo::Error when stamps go backwards (out-of-order input).
+  FrameResult ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_sequence,
+                            const std::vector<RigInput>& rigs,
+                            const std::optional<drivers::VehicleState>& vehicle,
+                            const std::optional<drivers::GnssFix>& gnss);
+
+  /// Counts a frame dropped upstream (reported in the status).
+  void CountDropped(int rig_id);
+  /// Counts a malformed network message (reported in the status).
+  void CountMalformed();
+  /// Adds a line to the next status' events.
+  void ReportEvent(const std::string& event);
+
+  const drivers::Calibration& calibration() const;
+  const PipelineParams& params() const;
+  const objects::Atlas& atlas() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace romo::pipeline

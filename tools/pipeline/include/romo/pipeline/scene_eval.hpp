@@ -1,0 +1,43 @@
+#pragma once
+/// Scores a run's outputs log against the simulator's ground truth channels (`romo eval scene`,
+/// and the report of `romo run`): detection precision/recall for cars and pedestrians within a
+/// range of the ego, box centre error, ID switches, prediction ADE/FDE and the parking slot.
+#include <cstdint>
+#include <string>
+
+namespace romo::pipeline {
+
+struct SceneEvalParams {
+  double range_m = 15.0;              ///< objects farther from the ego centre are not scored
+  double car_match_m = 1.5;           ///< detection-to-truth centre distance for a match
+  double pedestrian_match_m = 0.8;
+  double slot_match_m = 1.0;          ///< reported slot centre to bay centre for a match
+  double bay_visible_range_m = 10.0;  ///< a bay this close to the ego counts as fully visible
+};
+
+struct ClassScore {
+  std::int64_t truths = 0, detections = 0, matched_truths = 0, matched_detections = 0;
+  double precision() const { return detections ? double(matched_detections) / detections : 1.0; }
+  double recall() const { return truths ? double(matched_truths) / truths : 1.0; }
+};
+
+struct SceneEval {
+  std::int64_t frames = 0;
+  ClassScore car, pedestrian;
+  double box_center_err_m_median = 0.0;
+  std::int64_t id_switches = 0;
+  double ade_m = 0.0, fde_m = 0.0;
+  std::int64_t predictions_scored = 0;
+  std::int64_t slot_visible_frames = 0, slot_found_frames = 0;
+  double slot_center_err_m = 0.0;  ///< median over found frames
+  double slot_yaw_err_deg = 0.0;   ///< median over found frames
+  std::int64_t narrow_reported_feasible = 0;
+  /// {"frames":N, "car":{...}, ...} exactly as the issue specifies.
+  std::string ToJson() const;
+  std::string ToText() const;
+};
+
+/// @throws romo::Error when the log cannot be read or holds no ground truth frames.
+SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params = {});
+
+}  // namespace romo::pipeline

@@ -1,0 +1,231 @@
+#include "romo/pipeline/outputs.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "romo/core/check.hpp"
+#include "romo/objects/prediction_log.hpp"
+#include "romo/planning_iface/lcm_bus.hpp"
+#include "romo/viz/top_view.hpp"
+
+namespace romo::pipeline {
+namespace fs = std::filesystem;
+namespace pi = planning_iface;
+
+std::string JsonEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> OutputChannels() {
+  return {pi::kObstaclesChannel, pi::kParkingSlotsChannel, pi::kPerceptionStatusChannel,
+          objects::kPedestrianPredictionChannel};
+}
+
+class OutputSink::Impl {
+ public:
+  OutputOptions options;
+  std::unique_ptr<drivers::LogWriter> log;
+  std::unique_ptr<objects::PredictionCsvWriter> csv;
+  std::unique_ptr<pi::LcmBus> bus;
+  viz::TopViewParams view;
+  std::int64_t frames = 0;
+  bool finished = false;
+
+  // Summary state.
+  struct StageSummary {
+    std::optional<FrameResult> last;
+    std::vector<Eigen::Vector2d> trail;
+    std::int64_t first_seq = -1, last_seq = -1, frames = 0;
+  };
+  std::map<pi::ManeuverStage, StageSummary> stages;
+  std::map<std::string, double> stage_ms_sum;
+  std::vector<std::string> stage_order;
+  double total_ms_sum = 0;
+  std::int64_t missing_rig_frames = 0;
+  std::int64_t max_tracks = 0;
+  std::set<int> track_ids;
+  std::set<int> pedestrian_ids;
+  std::vector<std::string> events;
+  std::optional<pi::ParkingSlot> best_slot;
+  std::int64_t frames_with_feasible_slot = 0;
+  std::int64_t dropped = 0, malformed = 0;
+};
+
+OutputSink::OutputSink(const drivers::Calibration& calibration, const OutputOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+  impl_->view.size_px = options.picture_size_px;
+  impl_->view.Validate();
+  if (!options.out_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(fs::path(options.out_dir) / "frames", ec);
+    if (ec) Fail("outputs: cannot create folder " + options.out_dir + ": " + ec.message());
+    impl_->log = std::make_unique<drivers::LogWriter>(options.out_dir + "/outputs.lcmlog");
+    impl_->log->WriteCalibration(calibration, 0);
+    impl_->csv = std::make_unique<objects::PredictionCsvWriter>(options.out_dir + "/predictions.csv");
+  }
+  if (!options.lcm_url.empty()) impl_->bus = std::make_unique<pi::LcmBus>(options.lcm_url);
+}
+
+OutputSink::~OutputSink() {
+  try {
+    Finish();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "romo: outputs: %s\n", e.what());
+  }
+}
+
+std::int64_t OutputSink::frames_written() const { return impl_->frames; }
+
+std::string OutputSink::log_path() const {
+  return impl_->options.out_dir.empty() ? "" : impl_->options.out_dir + "/outputs.lcmlog";
+}
+
+void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
+                       const std::vector<drivers::LogEvent>& passthrough) {
+  Impl& s = *impl_;
+  const std::vector<std::pair<std::string, std::vector<std::uint8_t>>> messages = {
+      {pi::kObstaclesChannel, pi::Encode(r.obstacles)},
+      {pi::kParkingSlotsChannel, pi::Encode(r.slots)},
+      {pi::kPerceptionStatusChannel, pi::Encode(r.status)},
+      {objects::kPedestrianPredictionChannel,
+       objects::EncodePedestrianPredictions(r.stamp_ns, r.frame_sequence, r.predictions)}};
+  if (s.log) {
+    if (inputs != nullptr && s.options.log_inputs) s.log->Write(*inputs);
+    for (const auto& e : passthrough) {
+      s.log->WriteRaw(e.channel, r.stamp_ns, e.data.data(), e.data.size());
+    }
+    for (const auto& [channel, bytes] : messages) s.log->WriteRaw(channel, r.stamp_ns, bytes.data(), bytes.size());
+  }
+  if (s.bus) {
+    for (const auto& [channel, bytes] : messages) s.bus->Publish(channel, bytes);
+  }
+  if (s.csv) s.csv->WriteFrame(r.predictions);
+  if (!s.options.out_dir.empty() && s.options.frame_pictures) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "/frames/frame_%06lld.png", static_cast<long long>(r.frame_sequence));
+    viz::WritePng(s.options.out_dir + name, viz::DrawTopView(r, s.view, {}, ""));
+  }
+
+  // Summary bookkeeping.
+  ++s.frames;
+  for (const auto& st : r.status.stages) {
+    if (!s.stage_ms_sum.count(st.name)) s.stage_order.push_back(st.name);
+    s.stage_ms_sum[st.name] += st.latency_ms;
+  }
+  s.total_ms_sum += r.status.total_latency_ms;
+  if (!r.missing_rigs.empty()) ++s.missing_rig_frames;
+  s.max_tracks = std::max<std::int64_t>(s.max_tracks, static_cast<std::int64_t>(r.tracks.size()));
+  for (const auto& t : r.tracks) s.track_ids.insert(t.id);
+  for (const auto& p : r.predictions) s.pedestrian_ids.insert(p.track_id);
+  for (const auto& e : r.status.events) {
+    if (s.events.size() < 200) s.events.push_back("frame " + std::to_string(r.frame_sequence) + ": " + e);
+  }
+  s.dropped = r.status.frames_dropped;
+  s.malformed = r.status.malformed_messages;
+  bool feasible = false;
+  for (const auto& slot : r.slots.slots) {
+    if (slot.feasible) {
+      feasible = true;
+      if (!s.best_slot || slot.confidence >= s.best_slot->confidence) s.best_slot = slot;
+    }
+  }
+  if (feasible) ++s.frames_with_feasible_slot;
+  const pi::ManeuverStage stage = r.slots.stage;
+  if (stage == pi::ManeuverStage::kApproach || stage == pi::ManeuverStage::kTurn ||
+      stage == pi::ManeuverStage::kSideways) {
+    auto& sum = s.stages[stage];
+    if (sum.first_seq < 0) sum.first_seq = r.frame_sequence;
+    sum.last_seq = r.frame_sequence;
+    ++sum.frames;
+    sum.trail.push_back(r.ego_world.position_m);
+    sum.last = r;
+  }
+}
+
+void OutputSink::Finish(const std::string& extra_json) {
+  Impl& s = *impl_;
+  if (s.finished) return;
+  s.finished = true;
+  if (s.log) s.log->Close();
+  if (s.csv) s.csv->Close();
+  if (s.options.out_dir.empty()) return;
+
+  std::ostringstream stages_json;
+  bool first = true;
+  for (const auto& [stage, sum] : s.stages) {
+    const std::string name = pi::ToString(stage);
+    const std::string file = "stage_" + name + ".png";
+    char title[96];
+    std::snprintf(title, sizeof(title), "[%s: frames %lld-%lld]", name.c_str(),
+                  static_cast<long long>(sum.first_seq), static_cast<long long>(sum.last_seq));
+    viz::WritePng(s.options.out_dir + "/" + file, viz::DrawTopView(*sum.last, s.view, sum.trail, title));
+    stages_json << (first ? "" : ",") << "\"" << name << "\":{\"frames\":" << sum.frames
+                << ",\"first_frame\":" << sum.first_seq << ",\"last_frame\":" << sum.last_seq
+                << ",\"picture\":\"" << file << "\"}";
+    first = false;
+  }
+
+  std::ostringstream js;
+  js.setf(std::ios::fixed);
+  js.precision(3);
+  js << "{\n  \"frames\": " << s.frames << ",\n  \"frames_dropped\": " << s.dropped
+     << ",\n  \"malformed_messages\": " << s.malformed
+     << ",\n  \"frames_with_missing_rigs\": " << s.missing_rig_frames << ",\n  \"latency_ms_mean\": {";
+  for (std::size_t i = 0; i < s.stage_order.size(); ++i) {
+    js << (i ? ", " : "") << "\"" << s.stage_order[i]
+       << "\": " << (s.frames ? s.stage_ms_sum[s.stage_order[i]] / s.frames : 0.0);
+  }
+  js << (s.stage_order.empty() ? "" : ", ") << "\"total\": " << (s.frames ? s.total_ms_sum / s.frames : 0.0)
+     << "},\n  \"tracks_total\": " << s.track_ids.size() << ",\n  \"pedestrian_tracks\": "
+     << s.pedestrian_ids.size() << ",\n  \"frames_with_feasible_slot\": " << s.frames_with_feasible_slot
+     << ",\n  \"best_slot\": ";
+  if (s.best_slot) {
+    const auto& b = *s.best_slot;
+    js << "{\"id\": " << b.slot_id << ", \"center_world_m\": [" << b.target.position_m.x() << ", "
+       << b.target.position_m.y() << "], \"yaw_world_rad\": " << b.target.yaw_rad
+       << ", \"length_m\": " << b.length_m << ", \"depth_m\": " << b.depth_m
+       << ", \"confidence\": " << b.confidence << ", \"approach_world_m\": [" << b.approach.position_m.x()
+       << ", " << b.approach.position_m.y() << "], \"clearance_prev_m\": " << b.clearance_prev_m
+       << ", \"clearance_next_m\": " << b.clearance_next_m << "}";
+  } else {
+    js << "null";
+  }
+  js << ",\n  \"stages\": {" << stages_json.str() << "},\n  \"events\": [";
+  for (std::size_t i = 0; i < s.events.size(); ++i) {
+    js << (i ? ", " : "") << "\"" << JsonEscape(s.events[i]) << "\"";
+  }
+  js << "],\n  \"files\": {\"log\": \"outputs.lcmlog\", \"predictions\": \"predictions.csv\", \"frames\": \"frames/\"}";
+  if (!extra_json.empty()) js << ",\n  " << extra_json;
+  js << "\n}\n";
+  const std::string path = s.options.out_dir + "/summary.json";
+  std::ofstream f(path + ".partial");
+  f << js.str();
+  f.close();
+  if (!f) Fail("outputs: cannot write " + path);
+  fs::rename(path + ".partial", path);
+}
+
+}  // namespace romo::pipeline

@@ -1,0 +1,382 @@
+#include "romo/pipeline/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "romo/core/check.hpp"
+#include "romo/objects/atlas.hpp"
+#include "romo/objects/geo.hpp"
+#include "romo/stereo/multi_rig.hpp"
+
+namespace romo::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+double YawOf(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d x = T.rotation().col(0);
+  return std::atan2(x.y(), x.x());
+}
+
+Eigen::Vector2d Rotate(const Eigen::Vector2d& v, double yaw) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+}
+
+}  // namespace
+
+mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
+  mapping::SegmentationParams p;
+  p.leaf_size_m = 0.15f;
+  p.min_blob_points = 30;
+  // A car is at most ~5.5 m long: a bigger blob is several objects touching (or a hedge).
+  p.max_object_extent_m = 7.0f;
+  p.refine_factor = 0.5f;
+  p.max_refine_levels = 1;
+  return p;
+}
+
+void PipelineParams::Validate() const {
+  if (threads < 1 || threads > 64) Fail("pipeline: threads must be 1..64, got " + std::to_string(threads));
+  if (disparity_size < 16 || disparity_size > 256 || disparity_size % 16 != 0) {
+    Fail("pipeline: disparity_size must be a multiple of 16 in [16, 256], got " +
+         std::to_string(disparity_size));
+  }
+  if (!(max_range_m > 0) || !std::isfinite(max_range_m)) {
+    Fail("pipeline: max_range_m must be > 0, got " + std::to_string(max_range_m));
+  }
+  if (!(min_object_height_m >= 0)) {
+    Fail("pipeline: min_object_height_m must be >= 0, got " + std::to_string(min_object_height_m));
+  }
+  fusion.Validate();
+  ground.Validate();
+  segmentation.Validate();
+  tracker.Validate();
+  parking.Validate();
+}
+
+class Pipeline::Impl {
+ public:
+  Impl(const drivers::Calibration& c, const PipelineParams& p)
+      : calibration(c),
+        params(p),
+        atlas(objects::Atlas::Load(p.atlas_path.empty() ? objects::Atlas::DefaultPath() : p.atlas_path)),
+        tracker(atlas, p.tracker),
+        slots(p.parking),
+        stereo(c, StereoParamsOf(p), p.threads) {}
+
+  static stereo::StereoParams StereoParamsOf(const PipelineParams& p) {
+    stereo::StereoParams sp;
+    sp.disparity_size = p.disparity_size;
+    sp.reprojection.max_range_m = p.max_range_m;
+    sp.sgm.path_count = stereo::PathCount::k3;  // fastest mode; ample for obstacle boxes
+    return sp;
+  }
+
+  drivers::Calibration calibration;
+  PipelineParams params;
+  objects::Atlas atlas;
+  objects::Tracker tracker;
+  planning_iface::ParkingSlotEstimator slots;
+  planning_iface::ManeuverStageTracker stage;
+  stereo::MultiRigStereo stereo;
+
+  std::optional<std::int64_t> first_stamp_ns;
+  std::optional<std::int64_t> last_stamp_ns;
+  Eigen::Isometry3d last_T_world_vehicle = Eigen::Isometry3d::Identity();
+  bool have_vehicle = false;
+  std::optional<objects::LocalEnu> enu;
+  Eigen::Isometry3d T_enu_world = Eigen::Isometry3d::Identity();
+  bool gnss_gap = false;
+
+  struct RigCounters {
+    std::int64_t frames = 0;
+    std::int64_t dropped = 0;
+    std::optional<std::int64_t> first_stamp_ns;
+    std::int64_t last_stamp_ns = 0;
+  };
+  std::map<int, RigCounters> rigs;
+  std::int64_t frames_processed = 0;
+  std::int64_t frames_dropped = 0;
+  std::int64_t malformed = 0;
+  std::vector<std::string> events;
+};
+
+Pipeline::Pipeline(const drivers::Calibration& calibration, const PipelineParams& params) {
+  params.Validate();
+  if (calibration.rigs.empty()) Fail("pipeline: the calibration has no rigs");
+  impl_ = std::make_unique<Impl>(calibration, params);
+}
+
+Pipeline::~Pipeline() = default;
+
+const drivers::Calibration& Pipeline::calibration() const { return impl_->calibration; }
+const PipelineParams& Pipeline::params() const { return impl_->params; }
+const objects::Atlas& Pipeline::atlas() const { return impl_->atlas; }
+
+void Pipeline::CountDropped(int rig_id) {
+  ++impl_->rigs[rig_id].dropped;
+  ++impl_->frames_dropped;
+}
+void Pipeline::CountMalformed() { ++impl_->malformed; }
+void Pipeline::ReportEvent(const std::string& event) { impl_->events.push_back(event); }
+
+namespace {
+RigInput ToInput(const stereo::RigResult& rr, std::int64_t stamp_ns) {
+  RigInput in;
+  in.rig_id = rr.rig_id;
+  in.stamp_ns = stamp_ns;
+  in.cloud = rr.cloud_vehicle;
+  in.stereo_ms = rr.total_ms;
+  return in;
+}
+}  // namespace
+
+std::optional<RigInput> Pipeline::Stereo(const drivers::StereoFrame& frame) {
+  const stereo::RigResult rr = impl_->stereo.ProcessRig(frame);
+  if (!rr.ok) {
+    CountDropped(frame.rig_id);
+    ReportEvent("rig " + std::to_string(frame.rig_id) + " stereo failed: " + rr.error);
+    return std::nullopt;
+  }
+  return ToInput(rr, frame.stamp_ns());
+}
+
+FrameResult Pipeline::Process(const drivers::FrameSet& frames) {
+  const auto t0 = Clock::now();
+  const std::vector<stereo::RigResult> results = impl_->stereo.Process(frames);
+  std::vector<RigInput> rigs;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (results[i].ok) {
+      rigs.push_back(ToInput(results[i], frames.stereo[i].stamp_ns()));
+    } else {
+      CountDropped(results[i].rig_id);
+      ReportEvent("rig " + std::to_string(results[i].rig_id) + " stereo failed: " + results[i].error);
+    }
+  }
+  const double stereo_ms = MsSince(t0);
+  FrameResult r = ProcessClouds(frames.stamp_ns, static_cast<std::int64_t>(frames.sequence), rigs,
+                                frames.vehicle, frames.gnss);
+  r.status.stages.insert(r.status.stages.begin(), {"stereo", stereo_ms});
+  r.status.total_latency_ms += stereo_ms;
+  return r;
+}
+
+FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_sequence,
+                                    const std::vector<RigInput>& rigs,
+                                    const std::optional<drivers::VehicleState>& vehicle,
+                                    const std::optional<drivers::GnssFix>& gnss) {
+  Impl& s = *impl_;
+  if (s.last_stamp_ns && stamp_ns <= *s.last_stamp_ns) {
+    Fail("pipeline: frame " + std::to_string(frame_sequence) + " stamp " + std::to_string(stamp_ns) +
+         " ns is not after the previous frame's " + std::to_string(*s.last_stamp_ns) +
+         " ns (out-of-order input)");
+  }
+  if (!s.first_stamp_ns) s.first_stamp_ns = stamp_ns;
+  s.last_stamp_ns = stamp_ns;
+  const auto t_frame = Clock::now();
+  FrameResult r;
+  r.stamp_ns = stamp_ns;
+  r.frame_sequence = frame_sequence;
+  std::vector<std::string> events;
+  events.swap(s.events);
+
+  // Vehicle pose (world frame) from odometry; without it the last pose stands and is reported.
+  if (vehicle) {
+    s.last_T_world_vehicle = vehicle->T_world_vehicle;
+    s.have_vehicle = true;
+  } else {
+    events.push_back(s.have_vehicle ? "no vehicle state: last pose kept"
+                                    : "no vehicle state: world frame = first vehicle frame");
+  }
+  r.T_world_vehicle = s.last_T_world_vehicle;
+  r.ego_world.position_m = r.T_world_vehicle.translation().head<2>();
+  r.ego_world.yaw_rad = YawOf(r.T_world_vehicle);
+
+  // Stage: fusion.
+  auto t0 = Clock::now();
+  std::vector<mapping::RigCloud> inputs;
+  std::map<int, int> points_per_rig;
+  for (const auto& in : rigs) {
+    s.calibration.rig(in.rig_id);  // throws for an unknown rig id
+    mapping::RigCloud m;
+    m.rig_id = in.rig_id;
+    m.stamp_ns = in.stamp_ns;
+    m.T_vehicle_rig = Eigen::Isometry3f::Identity();  // stereo delivers vehicle-frame points
+    m.cloud = in.cloud;
+    inputs.push_back(std::move(m));
+    points_per_rig[in.rig_id] = static_cast<int>(in.cloud.size());
+    auto& counters = s.rigs[in.rig_id];
+    ++counters.frames;
+    if (!counters.first_stamp_ns) counters.first_stamp_ns = in.stamp_ns;
+    counters.last_stamp_ns = in.stamp_ns;
+  }
+  for (const auto& rc : s.calibration.rigs) {
+    if (!points_per_rig.count(rc.rig_id)) {
+      r.missing_rigs.push_back(rc.rig_id);
+      ++s.rigs[rc.rig_id].dropped;
+      events.push_back("rig " + std::to_string(rc.rig_id) + " (" + rc.name +
+                       ") missing: its sector is not covered");
+    }
+  }
+  mapping::VehicleMotion motion;
+  motion.reference_stamp_ns = stamp_ns;
+  if (vehicle) {
+    motion.speed_mps = static_cast<float>(vehicle->speed_mps);
+    motion.yaw_rate_radps = static_cast<float>(vehicle->yaw_rate_radps);
+  }
+  r.cloud = mapping::FuseRigClouds(inputs, motion, s.params.fusion);
+  r.status.stages.push_back({"fusion", MsSince(t0)});
+
+  // Stage: ground removal.
+  t0 = Clock::now();
+  mapping::GroundRemoval ground = mapping::RemoveGround(r.cloud, s.params.ground);
+  r.ground_plane = ground.plane;
+  r.ground_refined = ground.refined;
+  r.ground_indices = std::move(ground.ground);
+  r.status.stages.push_back({"ground", MsSince(t0)});
+
+  // Stage: segmentation.
+  t0 = Clock::now();
+  mapping::Segmentation seg = mapping::SegmentBlobs(r.cloud.xyz, s.params.segmentation, &ground.obstacles);
+  r.status.stages.push_back({"segmentation", MsSince(t0)});
+
+  // Stage: boxes (vertical cuboids about the ground normal, heading hinted by the tracks).
+  t0 = Clock::now();
+  const Eigen::Vector3f up = r.ground_plane.normal.normalized();
+  for (auto& blob : seg.blobs) {
+    const Eigen::Vector3f c = r.cloud.xyz(Eigen::all, blob).rowwise().mean();
+    const Eigen::Vector2d c_world =
+        (r.T_world_vehicle * Eigen::Vector3d(c.x(), c.y(), 0.0)).head<2>();
+    std::optional<float> hint;
+    if (auto h = s.tracker.YawHint(c_world)) hint = static_cast<float>(*h - r.ego_world.yaw_rad);
+    objects::Box3 box = objects::FitVerticalBox(r.cloud.xyz, blob, up, hint);
+    if (box.size.z() < s.params.min_object_height_m) continue;
+    r.boxes.push_back(box);
+    r.blobs.push_back(std::move(blob));
+  }
+  r.status.stages.push_back({"boxes", MsSince(t0)});
+
+  // Stage: classes (Atlas priors), detections in the world frame for tracking.
+  t0 = Clock::now();
+  std::vector<objects::Detection> detections;
+  for (const auto& box : r.boxes) {
+    objects::Detection d = objects::Detection::FromBox(box, s.atlas);
+    d.xy_m = (r.T_world_vehicle * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
+    d.yaw_rad += r.ego_world.yaw_rad;
+    r.box_classes.push_back(s.atlas.classes()[d.classification.class_index].name);
+    detections.push_back(d);
+  }
+  r.status.stages.push_back({"classes", MsSince(t0)});
+
+  // Stage: tracks.
+  t0 = Clock::now();
+  const double t_s = (stamp_ns - *s.first_stamp_ns) * 1e-9;
+  r.tracks = s.tracker.Update(t_s, detections);
+  r.status.stages.push_back({"tracks", MsSince(t0)});
+
+  // Stage: pedestrian predictions in vehicle frame, local ENU and WGS84.
+  t0 = Clock::now();
+  objects::PredictionFrames frames;
+  frames.T_vehicle_track = r.T_world_vehicle.inverse();
+  if (gnss && gnss->valid) {
+    if (!s.enu) {
+      s.enu.emplace(objects::Wgs84{gnss->latitude_deg, gnss->longitude_deg, gnss->altitude_m});
+    }
+    frames.T_enu_vehicle = objects::VehiclePoseInEnu(*s.enu, *gnss, r.ego_world.yaw_rad);
+    s.T_enu_world = frames.T_enu_vehicle * r.T_world_vehicle.inverse();
+    if (s.gnss_gap) events.push_back("GNSS fix back");
+    s.gnss_gap = false;
+  } else {
+    if (!s.enu) {
+      // Without any fix yet ENU is the odometry world frame at a placeholder origin.
+      s.enu.emplace(objects::Wgs84{0.0, 0.0, 0.0});
+      events.push_back("no GNSS fix yet: WGS84 relative to lat 0, lon 0");
+    } else if (!s.gnss_gap) {
+      events.push_back("GNSS gap: ENU bridged by odometry");
+    }
+    s.gnss_gap = true;
+    frames.T_enu_vehicle = s.T_enu_world * r.T_world_vehicle;
+  }
+  r.predictions = objects::MakePedestrianPredictions(r.tracks, s.atlas, stamp_ns, *s.first_stamp_ns,
+                                                     frames, *s.enu, s.params.predictor);
+  r.status.stages.push_back({"predictions", MsSince(t0)});
+
+  // Obstacles: this frame's boxes with their track (vehicle frame).
+  r.obstacles.stamp_ns = stamp_ns;
+  r.obstacles.frame_sequence = frame_sequence;
+  std::vector<int> track_of(r.boxes.size(), -1);
+  std::vector<const objects::Track*> track_ptr(r.boxes.size(), nullptr);
+  for (const auto& tr : r.tracks) {
+    if (tr.detection_index >= 0 && tr.detection_index < static_cast<int>(r.boxes.size())) {
+      track_of[tr.detection_index] = tr.id;
+      track_ptr[tr.detection_index] = &tr;
+    }
+  }
+  for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+    planning_iface::Obstacle o;
+    o.track_id = track_of[i];
+    o.class_name = r.box_classes[i];
+    o.score = static_cast<float>(detections[i].classification.score);
+    o.center_m = r.boxes[i].center.cast<double>();
+    o.size_m = r.boxes[i].size.cast<double>();
+    o.yaw_rad = r.boxes[i].yaw_rad;
+    o.num_points = static_cast<int>(r.blobs[i].size());
+    if (track_ptr[i] != nullptr) {
+      o.velocity_mps = Rotate(track_ptr[i]->velocity_mps, -r.ego_world.yaw_rad);
+    }
+    r.obstacles.obstacles.push_back(o);
+  }
+
+  // Stage: parking slots from the parked cars (world frame, filtered over frames).
+  t0 = Clock::now();
+  std::vector<planning_iface::GroundBox> cars;
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    if (r.box_classes[i] != "car") continue;
+    planning_iface::GroundBox b;
+    b.center_m = detections[i].xy_m;
+    b.yaw_rad = detections[i].yaw_rad;
+    b.length_m = detections[i].length_m;
+    b.width_m = detections[i].width_m;
+    b.id = track_of[i];
+    cars.push_back(b);
+  }
+  r.slots.stamp_ns = stamp_ns;
+  r.slots.frame_sequence = frame_sequence;
+  r.slots.ego_world = r.ego_world;
+  r.slots.stage = s.stage.Update(stamp_ns, r.ego_world);
+  r.slots.slots = s.slots.Update(cars, r.ego_world);
+  r.status.stages.push_back({"parking", MsSince(t0)});
+
+  // Status.
+  ++s.frames_processed;
+  r.status.stamp_ns = stamp_ns;
+  r.status.frame_sequence = frame_sequence;
+  for (const auto& rc : s.calibration.rigs) {
+    const auto& c = s.rigs[rc.rig_id];
+    planning_iface::RigStatus st;
+    st.rig_id = rc.rig_id;
+    st.present = points_per_rig.count(rc.rig_id) > 0;
+    st.frames = c.frames;
+    st.dropped = c.dropped;
+    st.points = st.present ? points_per_rig[rc.rig_id] : 0;
+    if (c.first_stamp_ns && c.last_stamp_ns > *c.first_stamp_ns && c.frames > 1) {
+      st.frame_rate_hz = (c.frames - 1) / ((c.last_stamp_ns - *c.first_stamp_ns) * 1e-9);
+    }
+    r.status.rigs.push_back(st);
+  }
+  r.status.total_latency_ms = MsSince(t_frame);
+  r.status.frames_processed = s.frames_processed;
+  r.status.frames_dropped = s.frames_dropped;
+  r.status.malformed_messages = s.malformed;
+  r.status.events = std::move(events);
+  return r;
+}
+
+}  // namespace romo::pipeline

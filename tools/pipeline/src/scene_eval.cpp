@@ -1,0 +1,230 @@
+#include "romo/pipeline/scene_eval.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "romo/core/check.hpp"
+#include "romo/drivers/recording.hpp"
+#include "romo/objects/prediction_log.hpp"
+#include "romo/objects/tracking_eval.hpp"
+#include "romo/planning_iface/messages.hpp"
+#include "romo/sim/ground_truth.hpp"
+
+namespace romo::pipeline {
+namespace pi = planning_iface;
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct Frame {
+  std::optional<sim::GroundTruth> truth;
+  std::optional<pi::ObstacleList> obstacles;
+  std::optional<pi::ParkingSlotReport> slots;
+  std::vector<objects::PedestrianPrediction> predictions;
+};
+
+// Greedy one-to-one matching by distance (small scenes: a handful of objects per class).
+std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth,
+                                       const std::vector<Eigen::Vector2d>& det, double max_m) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    for (std::size_t j = 0; j < det.size(); ++j) {
+      const double d = (truth[i] - det[j]).norm();
+      if (d <= max_m) pairs.emplace_back(d, static_cast<int>(i), static_cast<int>(j));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<bool> ti(truth.size()), dj(det.size());
+  std::vector<std::pair<int, int>> out;
+  for (const auto& [d, i, j] : pairs) {
+    if (ti[i] || dj[j]) continue;
+    ti[i] = dj[j] = true;
+    out.emplace_back(i, j);
+  }
+  return out;
+}
+
+}  // namespace
+
+SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
+  std::int64_t truncated = -1;
+  const auto events = drivers::ReadAllEvents(log_path, &truncated);
+  std::map<std::int64_t, Frame> frames;  // by stamp_ns
+  for (const auto& e : events) {
+    if (e.channel == sim::kGroundTruthChannel) {
+      auto gt = sim::DecodeGroundTruth(e.data.data(), e.data.size(), log_path);
+      const auto stamp = gt.stamp_ns;
+      frames[stamp].truth = std::move(gt);
+    } else if (e.channel == pi::kObstaclesChannel) {
+      if (auto m = pi::DecodeObstacleList(e.data.data(), e.data.size(), nullptr)) frames[m->stamp_ns].obstacles = *m;
+    } else if (e.channel == pi::kParkingSlotsChannel) {
+      if (auto m = pi::DecodeParkingSlots(e.data.data(), e.data.size(), nullptr)) frames[m->stamp_ns].slots = *m;
+    } else if (e.channel == objects::kPedestrianPredictionChannel) {
+      auto preds = objects::DecodePedestrianPredictions(e.data.data(), e.data.size());
+      if (!preds.empty()) frames[preds.front().stamp_ns].predictions = std::move(preds);
+    }
+  }
+  SceneEval out;
+  std::vector<double> center_errors, slot_center, slot_yaw;
+  objects::IdSwitchCounter switches(params.car_match_m);
+  std::vector<double> ade_list, fde_list;
+  // Truth positions of pedestrians over time for prediction scoring (world frame).
+  std::map<int, std::map<std::int64_t, Eigen::Vector2d>> ped_truth;
+  for (const auto& [stamp, f] : frames) {
+    if (!f.truth) continue;
+    for (const auto& o : f.truth->objects) {
+      if (o.class_name == "pedestrian") ped_truth[o.id][stamp] = o.center_m.head<2>();
+    }
+  }
+  for (const auto& [stamp, f] : frames) {
+    if (!f.truth || !f.obstacles) continue;
+    ++out.frames;
+    const Eigen::Isometry3d& T_wv = f.truth->T_world_vehicle;
+    const Eigen::Isometry3d T_vw = T_wv.inverse();
+    std::vector<objects::IdPosition> gt_ids, track_ids;
+    for (const std::string cls : {"car", "pedestrian"}) {
+      std::vector<Eigen::Vector2d> truth, det;
+      std::vector<int> truth_id, det_track;
+      for (const auto& o : f.truth->objects) {
+        if (o.class_name != cls) continue;
+        const Eigen::Vector2d v = (T_vw * o.center_m).head<2>();
+        if (v.norm() > params.range_m) continue;
+        truth.push_back(v);
+        truth_id.push_back(o.id);
+      }
+      for (const auto& o : f.obstacles->obstacles) {
+        if (o.class_name != cls || o.center_m.head<2>().norm() > params.range_m) continue;
+        det.push_back(o.center_m.head<2>());
+        det_track.push_back(o.track_id);
+      }
+      const auto m = Match(truth, det, cls == "car" ? params.car_match_m : params.pedestrian_match_m);
+      ClassScore& score = cls == "car" ? out.car : out.pedestrian;
+      score.truths += static_cast<std::int64_t>(truth.size());
+      score.detections += static_cast<std::int64_t>(det.size());
+      score.matched_truths += static_cast<std::int64_t>(m.size());
+      score.matched_detections += static_cast<std::int64_t>(m.size());
+      for (const auto& [i, j] : m) center_errors.push_back((truth[i] - det[j]).norm());
+      for (std::size_t i = 0; i < truth.size(); ++i) gt_ids.push_back({truth_id[i], truth[i]});
+      for (std::size_t j = 0; j < det.size(); ++j) {
+        if (det_track[j] >= 0) track_ids.push_back({det_track[j], det[j]});
+      }
+    }
+    switches.AddFrame(gt_ids, track_ids);
+
+    // Predictions: each predicted point against the truth at the same future instant, in the
+    // vehicle frame of the prediction's frame.
+    for (const auto& p : f.predictions) {
+      // The pedestrian this prediction is about: nearest truth to the observed position.
+      int best = -1;
+      double best_d = params.pedestrian_match_m;
+      for (const auto& o : f.truth->objects) {
+        if (o.class_name != "pedestrian") continue;
+        const double d = ((T_vw * o.center_m).head<2>() - p.observed.vehicle_xy_m).norm();
+        if (d < best_d) {
+          best_d = d;
+          best = o.id;
+        }
+      }
+      if (best < 0 || p.path.empty()) continue;
+      const auto& trail = ped_truth[best];
+      std::vector<double> errs;
+      for (const auto& pt : p.path) {
+        const std::int64_t t = p.observed_stamp_ns + static_cast<std::int64_t>(pt.dt_s * 1e9);
+        auto it = trail.lower_bound(t - 60'000'000);
+        if (it == trail.end() || std::llabs(it->first - t) > 60'000'000) {
+          errs.clear();
+          break;  // the horizon runs past the recording: not scored
+        }
+        const Eigen::Vector2d truth_v = (T_vw * Eigen::Vector3d(it->second.x(), it->second.y(), 0)).head<2>();
+        errs.push_back((truth_v - pt.vehicle_xy_m).norm());
+      }
+      if (errs.empty()) continue;
+      double sum = 0;
+      for (double e : errs) sum += e;
+      ade_list.push_back(sum / errs.size());
+      fde_list.push_back(errs.back());
+    }
+
+    // Parking: the feasible bays fully visible now, and any narrow bay reported feasible.
+    if (f.slots) {
+      for (const auto& bay : f.truth->bays) {
+        const Eigen::Vector2d bay_v = (T_vw * bay.center_m).head<2>();
+        const pi::ParkingSlot* found = nullptr;
+        double best = params.slot_match_m;
+        for (const auto& s : f.slots->slots) {
+          const double d = (s.target.position_m - bay.center_m.head<2>()).norm();
+          if (d < best) {
+            best = d;
+            found = &s;
+          }
+        }
+        if (!bay.feasible) {
+          if (found != nullptr && found->feasible) ++out.narrow_reported_feasible;
+          continue;
+        }
+        if (bay_v.norm() > params.bay_visible_range_m) continue;
+        ++out.slot_visible_frames;
+        if (found != nullptr && found->feasible) {
+          ++out.slot_found_frames;
+          slot_center.push_back(best);
+          double dyaw = std::fmod(std::abs(found->target.yaw_rad - bay.yaw_rad), kPi);
+          dyaw = std::min(dyaw, kPi - dyaw);
+          slot_yaw.push_back(dyaw * 180 / kPi);
+        }
+      }
+    }
+  }
+  if (out.frames == 0) {
+    Fail("eval scene: " + log_path + " has no frame with both ground truth (" +
+         sim::kGroundTruthChannel + ") and outputs (" + pi::kObstaclesChannel + ")");
+  }
+  out.box_center_err_m_median = Median(center_errors);
+  out.id_switches = switches.score().id_switches;
+  out.predictions_scored = static_cast<std::int64_t>(ade_list.size());
+  for (double a : ade_list) out.ade_m += a / ade_list.size();
+  for (double a : fde_list) out.fde_m += a / fde_list.size();
+  out.slot_center_err_m = Median(slot_center);
+  out.slot_yaw_err_deg = Median(slot_yaw);
+  return out;
+}
+
+std::string SceneEval::ToJson() const {
+  std::ostringstream js;
+  js.precision(4);
+  js << "{\"frames\":" << frames << ", \"car\":{\"precision\":" << car.precision()
+     << ", \"recall\":" << car.recall() << "}, \"pedestrian\":{\"precision\":" << pedestrian.precision()
+     << ", \"recall\":" << pedestrian.recall() << "}, \"box_center_err_m_median\":" << box_center_err_m_median
+     << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
+     << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
+     << ", \"center_err_m\":" << slot_center_err_m << ", \"yaw_err_deg\":" << slot_yaw_err_deg
+     << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}}";
+  return js.str();
+}
+
+std::string SceneEval::ToText() const {
+  std::ostringstream t;
+  t.precision(3);
+  t << "frames scored: " << frames << "\n"
+    << "cars (<= 15 m):        precision " << car.precision() << "  recall " << car.recall() << "  ("
+    << car.matched_truths << "/" << car.truths << " found, " << car.detections << " detections)\n"
+    << "pedestrians (<= 15 m): precision " << pedestrian.precision() << "  recall " << pedestrian.recall()
+    << "  (" << pedestrian.matched_truths << "/" << pedestrian.truths << " found, " << pedestrian.detections
+    << " detections)\n"
+    << "box centre error median: " << box_center_err_m_median << " m   ID switches: " << id_switches << "\n"
+    << "pedestrian prediction:  ADE " << ade_m << " m  FDE " << fde_m << " m (" << predictions_scored
+    << " predictions scored)\n"
+    << "parking slot: found in " << slot_found_frames << "/" << slot_visible_frames
+    << " frames where visible, centre error " << slot_center_err_m << " m, yaw error " << slot_yaw_err_deg
+    << " deg; narrow bay reported feasible " << narrow_reported_feasible << " times\n";
+  return t.str();
+}
+
+}  // namespace romo::pipeline
