@@ -351,10 +351,10 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     s.track.id = next_id_++;
     s.track.first_seen_s = stamp_s;
     s.track.last_seen_s = stamp_s;
-    s.track.hits = 1;
     s.track.detection_index = static_cast<int>(j);
     s.track.state = params_.confirm_hits <= 1 ? TrackState::kConfirmed : TrackState::kTentative;
-    Observe(&s, detections[j], stamp_s);
+    Observe(&s, detections[j], stamp_s);  // hits == 0 here: the first yaw is taken as measured
+    s.track.hits = 1;
     ++created_;
     kept.push_back(std::move(s));
   }
