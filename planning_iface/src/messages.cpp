@@ -121,7 +121,7 @@ bool WalkRigCloud(Walker& w) {
   std::int32_t points = 0, coords = 0;
   return w.Skip(8 + 16 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
          w.Skip(2 * static_cast<std::size_t>(coords)) && w.Skip(3 * static_cast<std::size_t>(points)) &&
-         w.Skip(8);
+         w.Skip(8 + 1 + 8 * 9);
 }
 
 bool Walk(const void* data, std::size_t size, bool (*walk)(Walker&), const char* type,
@@ -484,6 +484,18 @@ std::vector<std::uint8_t> Encode(const RigCloud& rc, double scale_m) {
   msg.num_points = static_cast<std::int32_t>(msg.sigma_q.size());
   msg.num_coords = 3 * msg.num_points;
   msg.dropped_out_of_range = dropped;
+  msg.has_vehicle = rc.vehicle.has_value();
+  if (rc.vehicle) {
+    const Eigen::Vector3d t = rc.vehicle->T_world_vehicle.translation();
+    const Eigen::Quaterniond q(rc.vehicle->T_world_vehicle.rotation());
+    for (int k = 0; k < 3; ++k) msg.position_m[k] = t[k];
+    msg.orientation_wxyz[0] = q.w();
+    msg.orientation_wxyz[1] = q.x();
+    msg.orientation_wxyz[2] = q.y();
+    msg.orientation_wxyz[3] = q.z();
+    msg.speed_mps = rc.vehicle->speed_mps;
+    msg.yaw_rate_radps = rc.vehicle->yaw_rate_radps;
+  }
   return EncodeMessage(msg);
 }
 
@@ -514,6 +526,22 @@ std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::
     }
   }
   RigCloud out;
+  if (msg.has_vehicle) {
+    const Eigen::Quaterniond q(msg.orientation_wxyz[0], msg.orientation_wxyz[1], msg.orientation_wxyz[2],
+                               msg.orientation_wxyz[3]);
+    if (!Finite(msg.position_m, 3) || !Finite(msg.orientation_wxyz, 4) || !std::isfinite(msg.speed_mps) ||
+        !std::isfinite(msg.yaw_rate_radps) || std::abs(q.norm() - 1.0) > 1e-3) {
+      SetWhy(why, "rig_cloud_t vehicle state is not finite or its quaternion is not unit");
+      return std::nullopt;
+    }
+    drivers::VehicleState v;
+    v.stamp_ns = msg.stamp_ns;
+    v.T_world_vehicle = Eigen::Translation3d(msg.position_m[0], msg.position_m[1], msg.position_m[2]) *
+                        q.normalized();
+    v.speed_mps = msg.speed_mps;
+    v.yaw_rate_radps = msg.yaw_rate_radps;
+    out.vehicle = v;
+  }
   out.stamp_ns = msg.stamp_ns;
   out.frame_sequence = msg.frame_sequence;
   out.rig_id = msg.rig_id;

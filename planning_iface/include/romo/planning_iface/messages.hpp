@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "romo/core/point_cloud.hpp"
+#include "romo/drivers/frames.hpp"
 #include "romo/planning_iface/parking_slot.hpp"
 
 namespace romo::planning_iface {
@@ -89,6 +90,7 @@ struct RigCloud {
   PointCloud cloud;
   int dropped_out_of_range = 0;  ///< points the compact encoding could not hold
   double stereo_ms = 0.0;
+  std::optional<drivers::VehicleState> vehicle;  ///< odometry of the frame, when known
 };
 
 std::vector<std::uint8_t> Encode(const ObstacleList& list);
