@@ -97,8 +97,9 @@ PointCloud FuseRigClouds(const std::vector<RigCloud>& rigs, const VehicleMotion&
     // Group points by voxel; where several rigs share a voxel, keep only the rig that sees it
     // with the lowest sigma_z (the surface is counted once, at its best measurement).
     internal::FinitePoints finite = internal::GatherFinite(fused.xyz, nullptr);
-    const int depth = internal::VoxelDepthFor(finite.lo, finite.hi, params.overlap_voxel_m, "fusion overlap thinning");
-    std::vector<std::uint64_t> codes = internal::VoxelCodes(fused.xyz, finite.indices, finite.lo, params.overlap_voxel_m);
+    const Eigen::Vector3f origin = internal::SnappedOrigin(finite.lo, params.overlap_voxel_m);
+    const int depth = internal::VoxelDepthFor(origin, finite.hi, params.overlap_voxel_m, "fusion overlap thinning");
+    std::vector<std::uint64_t> codes = internal::VoxelCodes(fused.xyz, finite.indices, origin, params.overlap_voxel_m);
     std::vector<int> order = std::move(finite.indices);
     internal::RadixSortPairs(&codes, &order, 3 * depth);
     std::vector<char> keep(static_cast<std::size_t>(n), 1);

@@ -40,8 +40,8 @@ void VoxelOctree::Build(const Eigen::Matrix3Xf& xyz, const std::vector<int>* sub
   if (finite.indices.empty()) return;
   ROMO_THROW_UNLESS(finite.indices.size() < (std::size_t{1} << 31));
 
-  depth_ = internal::VoxelDepthFor(finite.lo, finite.hi, leaf_size_m_, "octree");
-  origin_ = finite.lo;
+  origin_ = internal::SnappedOrigin(finite.lo, leaf_size_m_);
+  depth_ = internal::VoxelDepthFor(origin_, finite.hi, leaf_size_m_, "octree");
   std::vector<std::uint64_t> codes = internal::VoxelCodes(xyz, finite.indices, origin_, leaf_size_m_);
   point_order_ = std::move(finite.indices);
   internal::RadixSortPairs(&codes, &point_order_, 3 * depth_);

@@ -110,29 +110,23 @@ SyntheticScene MakeParkingScene(std::size_t target_points, std::uint64_t seed, f
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> jitter(-0.3f, 0.3f);
   std::uniform_real_distribution<float> yaw_jitter(-0.05f, 0.05f);
-  std::vector<SceneObject> objects;
   using Shape = SceneObject::Shape;
-  // Two rows of parked cars on each side of a lane, 2.6 m bays.
-  for (float side : {-1.f, 1.f}) {
-    for (float row : {6.f, 14.f}) {
-      for (int bay = -7; bay <= 7; ++bay) {
-        if ((bay + static_cast<int>(row) + (side > 0 ? 1 : 0)) % 5 == 0) continue;  // free slots
-        SceneObject car;
-        car.shape = Shape::kBox;
-        car.center_xy = {2.6f * static_cast<float>(bay) + 0.3f * jitter(rng), side * row + jitter(rng)};
-        car.size = {4.5f, 1.8f, 1.5f};
-        car.yaw_rad = 0.5f * kPi + yaw_jitter(rng);
-        objects.push_back(car);
-      }
-    }
-  }
-  // Pedestrians on the lane and the pavements, poles between rows.
+  const auto area_of = [](const SceneObject& o) {
+    if (o.shape == Shape::kBox) return o.size.x() * o.size.y() + 2.f * (o.size.x() + o.size.y()) * o.size.z();
+    const float r = 0.5f * o.size.x();
+    return 2.f * kPi * r * o.size.z() + kPi * r * r;
+  };
+  std::vector<SceneObject> objects;
+  float area = 0.f;
+  // Pedestrians on the lane, then poles between the rows, then parked cars row by row (nearest
+  // rows first, 2.6 m bays, some free) until the cloud reaches target_points at kDensity.
   for (int k = 0; k < 12; ++k) {
     SceneObject ped;
     ped.shape = Shape::kCylinder;
-    ped.center_xy = {-16.f + 3.f * static_cast<float>(k) + jitter(rng), (k % 3 - 1) * 2.5f + jitter(rng)};
+    ped.center_xy = {-16.f + 3.f * static_cast<float>(k) + jitter(rng), static_cast<float>(k % 3 - 1) * 2.5f + jitter(rng)};
     ped.size = {0.5f, 0.5f, 1.75f};
     objects.push_back(ped);
+    area += area_of(ped);
   }
   for (int k = 0; k < 10; ++k) {
     SceneObject pole;
@@ -140,21 +134,27 @@ SyntheticScene MakeParkingScene(std::size_t target_points, std::uint64_t seed, f
     pole.center_xy = {-18.f + 4.f * static_cast<float>(k), (k % 2 ? 1.f : -1.f) * 10.f};
     pole.size = {0.15f, 0.15f, 3.f};
     objects.push_back(pole);
+    area += area_of(pole);
   }
-  // Density from the total sampled area so the cloud has about target_points points.
-  double area = 0;
-  for (const auto& o : objects) {
-    if (o.shape == Shape::kBox) {
-      area += o.size.x() * o.size.y() + 2.0 * (o.size.x() + o.size.y()) * o.size.z();
-    } else {
-      const double r = 0.5 * o.size.x();
-      area += 2.0 * kPi * r * o.size.z() + kPi * r * r;
+  constexpr float kDensity = 450.f;  // points per m^2: a 0.1 m neighbourhood holds ~14 points
+  const float needed = static_cast<float>(target_points) / kDensity;
+  for (int row = 0; area < needed; ++row) {
+    const float row_y = 6.f + 8.f * static_cast<float>(row / 2);
+    const float side = row % 2 ? 1.f : -1.f;
+    for (int bay = -7; bay <= 7 && area < needed; ++bay) {
+      if ((bay + row) % 5 == 0) continue;  // free slots
+      SceneObject car;
+      car.shape = Shape::kBox;
+      car.center_xy = {2.6f * static_cast<float>(bay) + 0.3f * jitter(rng), side * row_y + jitter(rng)};
+      car.size = {4.5f, 1.8f, 1.5f};
+      car.yaw_rad = 0.5f * kPi + yaw_jitter(rng);
+      objects.push_back(car);
+      area += area_of(car);
     }
   }
   SyntheticSceneParams params;
   params.ground_half_extent_m = ground_half_extent_m;
-  area += 4.0 * ground_half_extent_m * ground_half_extent_m;
-  params.density_per_m2 = static_cast<float>(static_cast<double>(target_points) / area);
+  params.density_per_m2 = static_cast<float>(target_points) / area;
   params.noise_m = 0.01f;
   params.seed = seed;
   return MakeSyntheticScene(objects, params);

@@ -38,6 +38,10 @@ FinitePoints GatherFinite(const Eigen::Matrix3Xf& xyz, const std::vector<int>* s
   return out;
 }
 
+Eigen::Vector3f SnappedOrigin(const Eigen::Vector3f& lo, float voxel_m) {
+  return ((lo.array() / voxel_m).floor() * voxel_m).matrix();
+}
+
 std::vector<std::uint64_t> VoxelCodes(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
                                       const Eigen::Vector3f& origin, float voxel_m) {
   std::vector<std::uint64_t> codes(indices.size());

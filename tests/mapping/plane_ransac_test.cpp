@@ -61,7 +61,8 @@ TEST(PlaneRansacTest, AxisConstraintPicksTheHorizontalPlaneOverALargerWall) {
   EXPECT_NEAR(floor_fit->plane.normal.z(), 1.f, kNormalTolerance);  // oriented to the axis
   EXPECT_NEAR(floor_fit->plane.d, 0.f, 0.01f);
   EXPECT_GE(floor_fit->inliers.size(), 2990u);  // 3-sigma band of 0.005 m noise at 0.02 m: ~all
-  EXPECT_LE(floor_fit->inliers.size(), 3000u + 40u);  // plus the wall's foot below 0.02 m
+  // Plus the wall's foot below 0.02 m: 6000 * 0.02 / 3 = 40 expected, +-20 at 3 sigma.
+  EXPECT_LE(floor_fit->inliers.size(), 3000u + 60u);
 }
 
 TEST(PlaneRansacTest, DegenerateInputReturnsNothing) {

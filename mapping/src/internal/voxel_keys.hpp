@@ -46,6 +46,10 @@ inline Eigen::Vector3i MortonDecode(std::uint64_t code) {
           static_cast<int>(CompactBits3(code >> 2))};
 }
 
+/// @p lo snapped down to a multiple of @p voxel_m: voxel boundaries stay at fixed positions of the
+/// frame whatever the cloud's extent, so the same surface gets the same voxels frame to frame.
+Eigen::Vector3f SnappedOrigin(const Eigen::Vector3f& lo, float voxel_m);
+
 /// Morton codes of the voxels (edge @p voxel_m, grid origin @p origin) of points @p indices.
 /// Coordinates must fit 21 bits; the caller checks the extent first (VoxelDepthFor).
 std::vector<std::uint64_t> VoxelCodes(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,

@@ -43,9 +43,10 @@ struct SyntheticScene {
 SyntheticScene MakeSyntheticScene(const std::vector<SceneObject>& objects,
                                   const SyntheticSceneParams& params);
 
-/// A vehicle-scale parking scene of about @p target_points points (no ground, as after ground
-/// removal): rows of parked cars, pedestrians, poles and bollards within ~25 m of the vehicle,
-/// all at least 0.5 m apart. Deterministic for a given @p seed.
+/// A vehicle-scale parking scene of @p target_points object points at ~450 points/m^2 (a stereo
+/// cloud's density at ~10 m): pedestrians on the lane, poles, and as many rows of parked cars
+/// (2.6 m bays, some free) as the point count needs; objects at least 0.4 m apart. Optional ground
+/// patch (same density, extra points). Deterministic for a given @p seed.
 SyntheticScene MakeParkingScene(std::size_t target_points, std::uint64_t seed,
                                 float ground_half_extent_m = 0.f);
 
