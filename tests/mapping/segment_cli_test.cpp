@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -10,6 +11,12 @@
 
 namespace romo::mapping {
 namespace {
+
+/// Runs the romo built with this tree (ROMO_BINARY when set, else the compile-time path).
+test::CommandResult Romo(const std::string& args) {
+  const char* env = std::getenv("ROMO_BINARY");
+  return test::RunShell(std::string(env != nullptr ? env : ROMO_TEST_BINARY) + " " + args);
+}
 
 int Count(const std::string& s, const std::string& what) {
   int n = 0;
@@ -37,7 +44,7 @@ TEST(SegmentCliTest, JsonReportsGroundPlaneAndOneBlobPerObject) {
   const SyntheticScene scene = MakeSyntheticScene({car, ped, pole}, sp);
   stereo::SavePcd(scene.cloud, dir / "scene.pcd");
 
-  const auto r = test::RunRomo("segment --pcd " + dir / "scene.pcd" + " --json --out " + dir / "out");
+  const auto r = Romo("segment --pcd " + dir / "scene.pcd" + " --json --out " + dir / "out");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"points\": " + std::to_string(scene.cloud.size())), std::string::npos) << r.out;
   float a = 0, b = 0, c = 0, d = 0;
@@ -56,16 +63,16 @@ TEST(SegmentCliTest, JsonReportsGroundPlaneAndOneBlobPerObject) {
 
 TEST(SegmentCliTest, BadInputExitsWithAClearError) {
   test::ScratchDir dir;
-  const auto missing = test::RunRomo("segment --pcd " + dir / "nope.pcd");
+  const auto missing = Romo("segment --pcd " + dir / "nope.pcd");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("nope.pcd"), std::string::npos) << missing.err;
   PointCloud one;
   one.PushBack(Eigen::Vector3f(1, 2, 3));
   stereo::SavePcd(one, dir / "one.pcd");
-  const auto leaf = test::RunRomo("segment --pcd " + dir / "one.pcd" + " --leaf 0");
+  const auto leaf = Romo("segment --pcd " + dir / "one.pcd" + " --leaf 0");
   EXPECT_EQ(leaf.exit_code, 2);
   EXPECT_NE(leaf.err.find("leaf_size_m"), std::string::npos) << leaf.err;
-  const auto single = test::RunRomo("segment --pcd " + dir / "one.pcd" + " --json --min-points 1");
+  const auto single = Romo("segment --pcd " + dir / "one.pcd" + " --json --min-points 1");
   ASSERT_EQ(single.exit_code, 0) << single.err;
   EXPECT_NE(single.out.find("\"points\": 1,"), std::string::npos) << single.out;
 }
