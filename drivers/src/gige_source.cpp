@@ -180,6 +180,22 @@ class GigeSource::Impl {
       }
       throw;
     }
+    // Acquisition starts only once every camera is configured, so all rigs begin together
+    // instead of the first ones filling their buffer pools while the others are still opening.
+    for (auto& rig : rigs_) {
+      for (Camera* camera : {&rig->left, &rig->right}) {
+        GError* error = nullptr;
+        arv_camera_start_acquisition(camera->camera, &error);
+        if (error) {
+          const std::string why = TakeError(&error);
+          for (auto& r : rigs_) {
+            CloseCamera(&r->left, /*stop=*/true);
+            CloseCamera(&r->right, /*stop=*/true);
+          }
+          Fail(origin_ + ": " + camera->label + ": cannot start acquisition: " + why);
+        }
+      }
+    }
     for (auto& rig : rigs_) {
       for (Camera* camera : {&rig->left, &rig->right}) {
         camera->thread = std::thread([this, camera] { Run(camera); });
@@ -200,9 +216,11 @@ class GigeSource::Impl {
     std::unique_lock<std::mutex> lock(mutex_);
     const auto stall_deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                    std::chrono::duration<double>(config_.stall_timeout_s));
-    // Rigs that have not delivered within a frame period of the first are left out of the set.
+    // Rigs that have not delivered within three frame periods (at least 0.3 s: grab threads of
+    // 12 cameras on a loaded machine lag) of the first are left out of the set. Only latency
+    // grows: sets queued behind a late one are already complete.
     const auto assemble_wait = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(max_period_s_));
+        std::chrono::duration<double>(std::max(3.0 * max_period_s_, 0.3)));
     const std::int64_t set_tolerance_ns = static_cast<std::int64_t>(0.5 * min_period_s_ * 1e9);
     while (true) {
       const Rig* oldest = nullptr;
@@ -302,7 +320,7 @@ class GigeSource::Impl {
 
   // Opens and configures @p camera and starts acquisition. Returns an empty string on success,
   // otherwise what went wrong; *fatal says whether retrying cannot help (configuration errors).
-  std::string TryOpen(Camera* camera, bool* fatal) {
+  std::string TryOpen(Camera* camera, bool* fatal, bool start = true) {
     *fatal = false;
     const GigeRigConfig& rig = camera->rig->config;
     GError* error = nullptr;
@@ -380,7 +398,7 @@ class GigeSource::Impl {
     camera->control_lost = false;
     camera->lost_handler = g_signal_connect(arv_camera_get_device(handle), "control-lost",
                                             G_CALLBACK(&Impl::OnControlLost), camera);
-    arv_camera_start_acquisition(handle, &error);
+    if (start) arv_camera_start_acquisition(handle, &error);
     if (error) {
       const std::string text = "cannot start acquisition: " + TakeError(&error);
       g_signal_handler_disconnect(arv_camera_get_device(handle), camera->lost_handler);
@@ -420,7 +438,7 @@ class GigeSource::Impl {
     std::string why;
     while (true) {
       bool fatal = false;
-      why = TryOpen(camera, &fatal);
+      why = TryOpen(camera, &fatal, /*start=*/false);
       if (why.empty()) return;
       if (fatal) Fail(origin_ + ": " + camera->label + ": " + why);
       if (Clock::now() >= deadline) break;
