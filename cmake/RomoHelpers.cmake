@@ -43,6 +43,8 @@ function(romo_add_gtest name)
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} romo_test_support GTest::gtest GTest::gtest_main)
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 120
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
-               ENVIRONMENT "ROMO_SHARED_DATA=${ROMO_SHARED_DIR}/data;ROMO_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROMO_BINARY=$<TARGET_FILE:romo>")
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT})
+  # Data, source and romo binary paths are compiled into romo_test_support (environment
+  # variables of the same names override them): gtest_discover_tests flattens list-valued
+  # ENVIRONMENT properties, so only the first entry would survive.
 endfunction()

@@ -72,7 +72,7 @@ CommandResult RunShell(const std::string& command_line) {
 }
 
 CommandResult RunRomo(const std::string& args) {
-  return RunShell(Env("ROMO_BINARY", "romo") + " " + args);
+  return RunShell(Env("ROMO_BINARY", ROMO_DEFAULT_BINARY) + " " + args);
 }
 
 void WriteFile(const std::string& path, const std::string& text) {
