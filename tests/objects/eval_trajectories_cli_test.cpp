@@ -1,10 +1,18 @@
 // `romo eval trajectories` end to end: JSON keys and figures, bad input exit codes.
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
 
 namespace romo {
 namespace {
+
+// romo_add_gtest's ENVIRONMENT list loses every entry after the first (its semicolons split the
+// PROPERTIES pairs), so ROMO_BINARY may be unset under ctest: fall back to the built binary.
+const bool kBinarySet = [] {
+  return setenv("ROMO_BINARY", ROMO_BUILT_BINARY, /*overwrite=*/0) == 0;
+}();
 
 TEST(EvalTrajectoriesCliTest, PrintsDocumentedJsonForHotel) {
   ROMO_REQUIRE_SHARED_DATA("eth_ucy/biwi_hotel.txt");
