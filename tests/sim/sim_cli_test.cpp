@@ -1,6 +1,8 @@
 // `romo sim` end to end: the recording it writes is byte-identical for 1 and 2 threads, reads
 // back through log:// with calibration, 6 rigs and ground truth, `romo info` accepts it, and bad
 // parameters exit non-zero with a clear message.
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include "romo/drivers/recording.hpp"
@@ -9,6 +11,14 @@
 
 namespace romo::sim {
 namespace {
+
+// RunRomo reads ROMO_BINARY; default it to the romo this test was built with.
+const bool kBinarySet = [] {
+#ifdef ROMO_SIM_TEST_BINARY
+  setenv("ROMO_BINARY", ROMO_SIM_TEST_BINARY, /*overwrite=*/0);
+#endif
+  return true;
+}();
 
 constexpr const char* kSmallRun = "sim --scene parking --seed 11 --frames 2 --first 60 --scale 0.25";
 
