@@ -146,7 +146,8 @@ void Wait(double seconds, Progress* progress, double* done_s) {
 }
 
 void Run(const Options& options, const std::string& self_args) {
-  if (!InPrivateNetworkNamespace()) {
+  // ROMO_NETNS_REEXEC marks the re-run, where /proc/1 may not be readable to compare against.
+  if (!InPrivateNetworkNamespace() && !std::getenv("ROMO_NETNS_REEXEC")) {
     std::string runner = options.netns_run;
     if (runner.empty() && std::getenv("ROMO_NETNS_RUN")) runner = std::getenv("ROMO_NETNS_RUN");
     if (runner.empty() && fs::exists("../shared/scripts/netns-run")) runner = fs::absolute("../shared/scripts/netns-run");
@@ -156,7 +157,7 @@ void Run(const Options& options, const std::string& self_args) {
     }
     // Re-run this same command inside the namespace.
     const std::string self = Link("/proc/self/exe");
-    const std::string command = "'" + runner + "' '" + self + "' " + self_args;
+    const std::string command = "ROMO_NETNS_REEXEC=1 '" + runner + "' '" + self + "' " + self_args;
     std::fflush(stdout);
     const int status = std::system(command.c_str());
     if (status != 0) throw CLI::RuntimeError(WIFEXITED(status) ? WEXITSTATUS(status) : kExitRuntimeFailure);
