@@ -71,8 +71,10 @@ CommandResult RunShell(const std::string& command_line) {
   return result;
 }
 
+std::string RomoBinary() { return Env("ROMO_BINARY", ROMO_DEFAULT_BINARY); }
+
 CommandResult RunRomo(const std::string& args) {
-  return RunShell(Env("ROMO_BINARY", ROMO_DEFAULT_BINARY) + " " + args);
+  return RunShell("'" + RomoBinary() + "' " + args);
 }
 
 void WriteFile(const std::string& path, const std::string& text) {

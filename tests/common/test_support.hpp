@@ -31,7 +31,9 @@ struct CommandResult {
   std::string out;  ///< stdout
   std::string err;  ///< stderr
 };
-/// Runs the built `romo` binary (ROMO_BINARY) with @p args (a shell-quoted string).
+/// The `romo` binary under test: ROMO_BINARY when set, else the one built with this tree.
+std::string RomoBinary();
+/// Runs RomoBinary() with @p args (a shell-quoted string).
 CommandResult RunRomo(const std::string& args);
 /// Runs an arbitrary shell command line.
 CommandResult RunShell(const std::string& command_line);

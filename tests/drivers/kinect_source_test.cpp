@@ -71,8 +71,7 @@ TEST(KinectSourceTest, FakenectReplayRecordsThroughTheSameCode) {
   // fakenect blocks at the end of a dump (libfreenect's sync API waits for the next frame), so
   // the dump holds more frames than are recorded.
   WriteFakenectDump(dir.path(), 10);
-  const char* romo = std::getenv("ROMO_BINARY");
-  ASSERT_NE(romo, nullptr);
+  const std::string romo = test::RomoBinary();
   const auto result = test::RunShell("timeout 120 fakenect '" + dir.path() + "' '" + romo +
                                      "' record --source kinect://0 --out '" + (dir / "k.lcmlog") +
                                      "' --frames 3");

@@ -112,7 +112,7 @@ TEST(RecordCliTest, SigintClosesTheFileCleanly) {
   test::ScratchDir dir;
   WriteInputLog(dir / "in.lcmlog", 5);
   // An endless source (looping at real time, 10 Hz) stopped by SIGINT after ~1 s.
-  const std::string romo = std::getenv("ROMO_BINARY") ? std::getenv("ROMO_BINARY") : "romo";
+  const std::string romo = test::RomoBinary();
   const auto result = test::RunShell(
       "'" + romo + "' record --source 'log://" + (dir / "in.lcmlog") + "?loop=1&pacing=realtime' --out '" +
       (dir / "out.lcmlog") + "' > '" + (dir / "stdout.txt") + "' 2>&1 & pid=$!; " +

@@ -9,6 +9,8 @@
 #include <string>
 #include <thread>
 
+#include "test_support.hpp"
+
 namespace romo::hil {
 
 /// A shell command run in the background (exec'd, so the pid is the command's own); killed with
@@ -52,10 +54,6 @@ inline bool WaitForFile(const std::string& path, double timeout_s) {
   return false;
 }
 
-/// The romo binary under test (ROMO_BINARY, set by CTest).
-inline std::string RomoBinary() {
-  const char* value = std::getenv("ROMO_BINARY");
-  return value ? value : "romo";
-}
+using ::romo::test::RomoBinary;
 
 }  // namespace romo::hil

@@ -12,11 +12,7 @@
 namespace romo::mapping {
 namespace {
 
-/// Runs the romo built with this tree (ROMO_BINARY when set, else the compile-time path).
-test::CommandResult Romo(const std::string& args) {
-  const char* env = std::getenv("ROMO_BINARY");
-  return test::RunShell(std::string(env != nullptr ? env : ROMO_TEST_BINARY) + " " + args);
-}
+test::CommandResult Romo(const std::string& args) { return test::RunRomo(args); }
 
 int Count(const std::string& s, const std::string& what) {
   int n = 0;

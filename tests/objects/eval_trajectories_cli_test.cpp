@@ -8,12 +8,6 @@
 namespace romo {
 namespace {
 
-// romo_add_gtest's ENVIRONMENT list loses every entry after the first (its semicolons split the
-// PROPERTIES pairs), so ROMO_BINARY may be unset under ctest: fall back to the built binary.
-const bool kBinarySet = [] {
-  return setenv("ROMO_BINARY", ROMO_BUILT_BINARY, /*overwrite=*/0) == 0;
-}();
-
 TEST(EvalTrajectoriesCliTest, PrintsDocumentedJsonForHotel) {
   ROMO_REQUIRE_SHARED_DATA("eth_ucy/biwi_hotel.txt");
   const std::string file = test::SharedData("eth_ucy/biwi_hotel.txt");

@@ -12,14 +12,6 @@
 namespace romo::sim {
 namespace {
 
-// RunRomo reads ROMO_BINARY; default it to the romo this test was built with.
-const bool kBinarySet = [] {
-#ifdef ROMO_SIM_TEST_BINARY
-  setenv("ROMO_BINARY", ROMO_SIM_TEST_BINARY, /*overwrite=*/0);
-#endif
-  return true;
-}();
-
 constexpr const char* kSmallRun = "sim --scene parking --seed 11 --frames 2 --first 60 --scale 0.25";
 
 TEST(SimCliTest, SameSeedSameBytesForOneAndTwoThreads) {
