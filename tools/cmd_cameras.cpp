@@ -5,27 +5,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command_registry.hpp"
+#include "romo/core/json.hpp"
 #include "romo/drivers/gige.hpp"
 
 namespace romo::tools {
 namespace {
-
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 void Register(CLI::App& root) {
   auto* command = root.add_subcommand(

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli/command_registry.hpp"
+#include "romo/core/json.hpp"
 #include "romo/core/check.hpp"
 #include "romo/objects/trajectory_eval.hpp"
 
@@ -21,24 +22,6 @@ struct Options {
   bool strict = false;
   bool json = false;
 };
-
-// Minimal JSON string escaping for the file path.
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 void Run(const Options& o) {
   if (o.format != "ethucy") Fail("--format: unknown trajectory format '" + o.format + "' (ethucy)");

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command_registry.hpp"
+#include "romo/core/json.hpp"
 #include "romo/drivers/recording.hpp"
 
 namespace romo::tools {
@@ -30,23 +31,6 @@ struct ChannelStats {
   double span_s() const { return static_cast<double>(last_us - first_us) * 1e-6; }
   double rate_hz() const { return count > 1 && last_us > first_us ? (count - 1) / span_s() : 0.0; }
 };
-
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 void Info(const std::string& path, bool json) {
   std::map<std::string, ChannelStats> channels;

@@ -50,6 +50,18 @@ void PointCloud::Transform(const Eigen::Isometry3f& T_to_from) {
   xyz = (T_to_from.linear() * xyz).colwise() + T_to_from.translation();
 }
 
+PointScatter ComputeScatter(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
+  ROMO_THROW_UNLESS(!indices.empty());
+  PointScatter s;
+  for (int i : indices) s.mean += xyz.col(i).cast<double>();
+  s.mean /= static_cast<double>(indices.size());
+  for (int i : indices) {
+    const Eigen::Vector3d q = xyz.col(i).cast<double>() - s.mean;
+    s.scatter.noalias() += q * q.transpose();
+  }
+  return s;
+}
+
 bool PointCloud::IsConsistent() const {
   return sigma_z_m.size() == size() && intensity.size() == size();
 }

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "romo/core/json.hpp"
 #include "romo/core/check.hpp"
 #include "romo/indoor_manip/manip_analyzer.hpp"
 
@@ -129,15 +130,6 @@ cv::Mat RotationPlot(const ManipResult& r) {
 
 void Write(const std::string& path, const cv::Mat& img) {
   if (!cv::imwrite(path, img)) Fail("cannot write plot '" + path + "'");
-}
-
-std::string JsonEscape(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
-  }
-  return out;
 }
 
 std::string Num(double v) {

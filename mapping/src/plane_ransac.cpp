@@ -1,3 +1,4 @@
+#include "romo/core/point_cloud.hpp"
 #include "romo/mapping/plane_ransac.hpp"
 
 #include <algorithm>
@@ -83,15 +84,9 @@ int RansacIterations(double success_probability, double outlier_fraction, int sa
 
 std::optional<Plane> FitPlaneLeastSquares(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
   if (indices.size() < 3) return std::nullopt;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int i : indices) mean += xyz.col(i).cast<double>();
-  mean /= static_cast<double>(indices.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int i : indices) {
-    const Eigen::Vector3d q = xyz.col(i).cast<double>() - mean;
-    cov.noalias() += q * q.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const PointScatter stats = ComputeScatter(xyz, indices);
+  const Eigen::Vector3d& mean = stats.mean;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(stats.scatter);
   if (eig.info() != Eigen::Success) return std::nullopt;
   // A plane needs two clearly non-zero spreads; the normal is the smallest one's direction.
   if (!(eig.eigenvalues()(1) > 1e-12 * std::max(1.0, eig.eigenvalues()(2)))) return std::nullopt;

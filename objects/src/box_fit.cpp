@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "romo/core/point_cloud.hpp"
 #include "romo/core/check.hpp"
 #include "romo/objects/box.hpp"
 
@@ -116,15 +117,9 @@ float CanonicalYaw(float yaw_rad, float* length_m, float* width_m, std::optional
 
 Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
   CheckIndices(xyz, indices, "FitPcaBox");
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int i : indices) mean += xyz.col(i).cast<double>();
-  mean /= static_cast<double>(indices.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int i : indices) {
-    const Eigen::Vector3d q = xyz.col(i).cast<double>() - mean;
-    cov.noalias() += q * q.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const PointScatter stats = ComputeScatter(xyz, indices);
+  const Eigen::Vector3d& mean = stats.mean;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(stats.scatter);
   Eigen::Matrix3f axes;
   axes.col(0) = eig.eigenvectors().col(2).cast<float>().normalized();  // largest variance
   axes.col(1) = eig.eigenvectors().col(1).cast<float>().normalized();

@@ -1,3 +1,4 @@
+#include "romo/core/json.hpp"
 #include "romo/pipeline/outputs.hpp"
 
 #include <cstdio>
@@ -16,27 +17,6 @@
 namespace romo::pipeline {
 namespace fs = std::filesystem;
 namespace pi = planning_iface;
-
-std::string JsonEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
 
 std::vector<std::string> OutputChannels() {
   return {pi::kObstaclesChannel, pi::kParkingSlotsChannel, pi::kPerceptionStatusChannel,

@@ -37,4 +37,13 @@ struct PointCloud {
   bool IsConsistent() const;
 };
 
+/// Mean and scatter matrix (sum of outer products about the mean) of the columns of @p xyz at
+/// @p indices, accumulated in double: the input of every PCA in romo (planes, boxes).
+struct PointScatter {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+};
+/// @pre @p indices is not empty and every index is a column of @p xyz.
+PointScatter ComputeScatter(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices);
+
 }  // namespace romo

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "romo/core/json.hpp"
 #include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frames.hpp"
 #include "romo/drivers/recording.hpp"
@@ -52,7 +53,6 @@ class OutputSink {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Escapes @p s for a JSON string literal (without the quotes).
-std::string JsonEscape(const std::string& s);
+using ::romo::JsonEscape;
 
 }  // namespace romo::pipeline
