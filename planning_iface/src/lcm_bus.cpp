@@ -12,9 +12,11 @@ class LcmBus::Impl {
 
   struct Subscription {
     Handler handler;
-    void Receive(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-      handler(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size,
-              rbuf->recv_utime);
+    // LCM's C callback: its C++ template wrapper fails UBSan's vptr check (LCM 1.3.1), so the
+    // subscription goes through the C API with this plain, non-polymorphic receiver.
+    static void Receive(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+      static_cast<Subscription*>(user)->handler(
+          channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, rbuf->recv_utime);
     }
   };
 
@@ -42,7 +44,10 @@ void LcmBus::Publish(const std::string& channel, const std::vector<std::uint8_t>
 void LcmBus::Subscribe(const std::string& channel_regex, Handler handler) {
   auto sub = std::make_unique<Impl::Subscription>();
   sub->handler = std::move(handler);
-  impl_->lcm.subscribe(channel_regex, &Impl::Subscription::Receive, sub.get());
+  if (lcm_subscribe(impl_->lcm.getUnderlyingLCM(), channel_regex.c_str(), &Impl::Subscription::Receive,
+                    sub.get()) == nullptr) {
+    Fail("LCM: cannot subscribe to '" + channel_regex + "' on '" + impl_->url + "'");
+  }
   impl_->subscriptions.push_back(std::move(sub));
 }
 
