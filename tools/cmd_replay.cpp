@@ -38,11 +38,7 @@ void Replay(const ReplayOptions& o) {
     Fail("replay: recording " + o.log +
          " has no calibration (no ROMO_CALIBRATION event): pass one with --calib FILE");
   }
-  pipeline::PipelineParams params;
-  params.threads = o.threads;
-  // Half-resolution images need half the disparity range for the same nearest depth.
-  params.disparity_size = calibration.rigs.front().width_px < 600 ? 64 : 128;
-  pipeline::Pipeline pipe(calibration, params);
+  pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, o.threads));
   pipeline::OutputOptions out;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;

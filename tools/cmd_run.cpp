@@ -50,10 +50,7 @@ void RunDefault(const RunCmdOptions& o) {
   const drivers::Calibration calibration = *source->calibration();
   auto* sim_source = dynamic_cast<sim::SimSource*>(source.get());
 
-  pipeline::PipelineParams params;
-  params.threads = o.threads;
-  params.disparity_size = calibration.rigs.front().width_px < 600 ? 64 : 128;
-  pipeline::Pipeline pipe(calibration, params);
+  pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, o.threads));
   pipeline::OutputOptions out;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;

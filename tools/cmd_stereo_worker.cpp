@@ -30,9 +30,8 @@ void Work(const WorkerOptions& o) {
   if (source->calibration() == nullptr) Fail("stereo-worker: source " + o.source + " has no calibration");
   const drivers::Calibration calibration = *source->calibration();
   calibration.rig(o.rig);  // names the rig when it is not in the calibration
-  pipeline::PipelineParams params;
-  params.threads = 1;  // one rig per process: the vehicle network spreads the rigs over cores
-  params.disparity_size = calibration.rigs.front().width_px < 600 ? 64 : 128;
+  // One rig per process: the vehicle network spreads the rigs over cores.
+  pipeline::PipelineParams params = pipeline::PipelineParams::ForCalibration(calibration, 1);
   pipeline::Pipeline pipe(calibration, params);
   planning_iface::LcmBus bus(o.lcm_url);
   long long sent = 0, missing = 0;

@@ -42,6 +42,14 @@ mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
   return p;
 }
 
+PipelineParams PipelineParams::ForCalibration(const drivers::Calibration& calibration, int threads) {
+  ROMO_THROW_UNLESS(!calibration.rigs.empty());
+  PipelineParams p;
+  p.threads = threads;
+  p.disparity_size = calibration.rigs.front().width_px < 600 ? 64 : 128;
+  return p;
+}
+
 void PipelineParams::Validate() const {
   if (threads < 1 || threads > 64) Fail("pipeline: threads must be 1..64, got " + std::to_string(threads));
   if (disparity_size < 16 || disparity_size > 256 || disparity_size % 16 != 0) {

@@ -41,6 +41,9 @@ struct PipelineParams {
   std::string atlas_path;  ///< "" = objects::Atlas::DefaultPath()
 
   static mapping::SegmentationParams DefaultSegmentation();
+  /// Defaults for @p calibration's image size (half-resolution images need half the disparity
+  /// range for the same nearest depth) with @p threads stereo threads.
+  static PipelineParams ForCalibration(const drivers::Calibration& calibration, int threads);
   /// @throws romo::Error naming the field and value.
   void Validate() const;
 };
