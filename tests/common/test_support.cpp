@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include "romo/core/check.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -75,6 +77,15 @@ std::string RomoBinary() { return Env("ROMO_BINARY", ROMO_DEFAULT_BINARY); }
 
 CommandResult RunRomo(const std::string& args) {
   return RunShell("'" + RomoBinary() + "' " + args);
+}
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const romo::Error& e) {
+    return e.what();
+  }
+  return "no error";
 }
 
 void WriteFile(const std::string& path, const std::string& text) {

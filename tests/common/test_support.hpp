@@ -1,5 +1,6 @@
 #pragma once
 /// Helpers shared by the test suites: external data, scratch folders, running the CLI.
+#include <functional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -37,6 +38,9 @@ std::string RomoBinary();
 CommandResult RunRomo(const std::string& args);
 /// Runs an arbitrary shell command line.
 CommandResult RunShell(const std::string& command_line);
+
+/// The message of the romo::Error @p f throws, or "no error".
+std::string ErrorOf(const std::function<void()>& f);
 
 /// Writes @p text into @p path (overwriting).
 void WriteFile(const std::string& path, const std::string& text);

@@ -18,6 +18,8 @@
 namespace romo::drivers {
 namespace {
 
+using ::romo::test::ErrorOf;
+
 constexpr std::int64_t kFramePeriodNs = 100'000'000;  // 10 Hz, the vehicle's camera rate
 constexpr std::int64_t kStartNs = 1'700'000'000'000'000'000;
 // Poses pass through a quaternion: doubles survive to ~1e-15, 1e-12 leaves room for rounding.
@@ -146,15 +148,6 @@ std::vector<FrameSet> ReadAll(LogReader* reader) {
   std::vector<FrameSet> sets;
   while (auto set = reader->Next()) sets.push_back(std::move(*set));
   return sets;
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const romo::Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(LogReaderTest, RawRoundTripReassemblesEveryFrameSet) {

@@ -15,6 +15,8 @@
 namespace romo::drivers {
 namespace {
 
+using ::romo::test::ErrorOf;
+
 // Stamps come from text seconds or from index / 30 Hz: 1 us covers double rounding.
 constexpr std::int64_t kStampToleranceNs = 1000;
 
@@ -22,15 +24,6 @@ std::vector<FrameSet> ReadAll(FrameSource* source) {
   std::vector<FrameSet> sets;
   while (auto set = source->Next()) sets.push_back(std::move(*set));
   return sets;
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const romo::Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 // The frame holds exactly the file's pixels (depth unchanged, colour as RGB).
