@@ -4,9 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "internal/grid_components.hpp"
 #include "internal/voxel_keys.hpp"
 #include "romo/core/check.hpp"
-#include "romo/mapping/octree.hpp"
 
 namespace romo::mapping {
 namespace {
@@ -15,54 +15,6 @@ void FailField(const char* field, double value, const char* rule) {
   std::ostringstream msg;
   msg << "SegmentationParams." << field << " = " << value << ": " << rule;
   Fail(msg.str());
-}
-
-/// Leaf components by iterative DFS over the 26-neighbourhood; returns one label per leaf.
-std::vector<int> LabelLeaves(const VoxelOctree& tree, int* component_count) {
-  const std::size_t leaves = tree.leaf_count();
-  std::vector<int> label(leaves, -1);
-  std::vector<std::uint32_t> stack;
-  stack.reserve(1024);
-  const std::uint32_t limit = 1u << tree.depth();
-  int next = 0;
-  for (std::size_t seed = 0; seed < leaves; ++seed) {
-    if (label[seed] >= 0) continue;
-    label[seed] = next;
-    stack.push_back(static_cast<std::uint32_t>(seed));
-    while (!stack.empty()) {
-      const std::uint32_t leaf = stack.back();
-      stack.pop_back();
-      const Eigen::Vector3i key = internal::MortonDecode(tree.LeafCode(leaf));
-      // Spread each neighbouring coordinate once; the 26 codes are ORs of these.
-      std::uint64_t sx[3], sy[3], sz[3];
-      bool vx[3], vy[3], vz[3];
-      for (int d = 0; d < 3; ++d) {
-        const std::int64_t x = key.x() + d - 1, y = key.y() + d - 1, z = key.z() + d - 1;
-        vx[d] = x >= 0 && x < limit;
-        vy[d] = y >= 0 && y < limit;
-        vz[d] = z >= 0 && z < limit;
-        sx[d] = vx[d] ? internal::SpreadBits3(static_cast<std::uint64_t>(x)) : 0;
-        sy[d] = vy[d] ? internal::SpreadBits3(static_cast<std::uint64_t>(y)) << 1 : 0;
-        sz[d] = vz[d] ? internal::SpreadBits3(static_cast<std::uint64_t>(z)) << 2 : 0;
-      }
-      for (int dz = 0; dz < 3; ++dz) {
-        if (!vz[dz]) continue;
-        for (int dy = 0; dy < 3; ++dy) {
-          if (!vy[dy]) continue;
-          for (int dx = 0; dx < 3; ++dx) {
-            if (!vx[dx] || (dx == 1 && dy == 1 && dz == 1)) continue;
-            const std::int64_t n = tree.FindLeafByCode(sx[dx] | sy[dy] | sz[dz]);
-            if (n < 0 || label[static_cast<std::size_t>(n)] >= 0) continue;
-            label[static_cast<std::size_t>(n)] = next;
-            stack.push_back(static_cast<std::uint32_t>(n));
-          }
-        }
-      }
-    }
-    ++next;
-  }
-  *component_count = next;
-  return label;
 }
 
 float Diagonal(const Eigen::Matrix3Xf& xyz, const std::vector<int>& blob) {
@@ -74,42 +26,60 @@ float Diagonal(const Eigen::Matrix3Xf& xyz, const std::vector<int>& blob) {
   return (hi - lo).norm();
 }
 
+/// Grid bytes allowed per point before a cloud counts as sparse: clearing and scanning a grid that
+/// size costs about what the octree path's per-point sort and hashing do.
+constexpr std::size_t kMaxGridBytesPerPoint = 32;
+constexpr std::size_t kSmallGridBytes = std::size_t{1} << 20;  // always worth it
+
+internal::PointComponents LabelPoints(const Eigen::Matrix3Xf& xyz, const std::vector<int>* subset,
+                                      const SegmentationParams& params, float leaf_m,
+                                      std::size_t* skipped_non_finite) {
+  internal::FinitePoints finite = internal::GatherFinite(xyz, subset);
+  *skipped_non_finite = finite.skipped_non_finite;
+  const std::size_t bytes = internal::DenseGridBytes(finite, leaf_m);
+  const std::size_t sparse_limit = kMaxGridBytesPerPoint * finite.indices.size() + kSmallGridBytes;
+  if (bytes <= params.dense_grid_max_bytes && bytes <= sparse_limit) {
+    return internal::DenseGridComponents(xyz, std::move(finite), leaf_m);
+  }
+  return internal::OctreeComponents(xyz, subset, leaf_m, skipped_non_finite);
+}
+
 void SegmentAtLeaf(const Eigen::Matrix3Xf& xyz, const std::vector<int>* subset,
                    const SegmentationParams& params, float leaf_m, int level, Segmentation* out) {
-  VoxelOctree tree(leaf_m);
-  tree.Build(xyz, subset);
+  std::size_t skipped = 0;
+  const internal::PointComponents pc = LabelPoints(xyz, subset, params, leaf_m, &skipped);
   if (level == 0) {
-    out->occupied_leaves = tree.leaf_count();
-    out->skipped_non_finite = tree.skipped_non_finite();
+    out->occupied_leaves = pc.occupied_voxels;
+    out->skipped_non_finite = skipped;
   }
-  int components = 0;
-  const std::vector<int> label = LabelLeaves(tree, &components);
-  std::vector<std::size_t> sizes(static_cast<std::size_t>(components), 0);
-  for (std::size_t leaf = 0; leaf < label.size(); ++leaf) sizes[label[leaf]] += tree.LeafPointCount(leaf);
-  std::vector<std::vector<int>> blobs(static_cast<std::size_t>(components));
-  for (int c = 0; c < components; ++c) {
-    if (static_cast<int>(sizes[c]) >= params.min_blob_points) blobs[c].reserve(sizes[c]);
+  const std::size_t components = pc.sizes.size();
+  const auto kept = [&](std::size_t c) { return pc.sizes[c] >= static_cast<std::uint32_t>(params.min_blob_points); };
+  std::vector<std::vector<int>> blobs(components);
+  for (std::size_t c = 0; c < components; ++c) {
+    if (kept(c)) blobs[c].reserve(pc.sizes[c]);
   }
-  if (level == 0) {
-    // Scatter labels to points, then gather in index order: ascending lists without a sort.
-    std::vector<int> point_label(static_cast<std::size_t>(xyz.cols()), -1);
-    for (std::size_t leaf = 0; leaf < label.size(); ++leaf) {
-      for (const int* p = tree.LeafPointsBegin(leaf); p != tree.LeafPointsEnd(leaf); ++p) point_label[*p] = label[leaf];
+  const std::size_t m = pc.indices.size();
+  if (pc.ascending) {
+    for (std::size_t k = 0; k < m; ++k) {
+      if (kept(pc.labels[k])) blobs[pc.labels[k]].push_back(pc.indices[k]);
     }
+  } else if (4 * m >= static_cast<std::size_t>(xyz.cols())) {
+    // Scatter labels to points, then gather in index order: ascending lists without a sort.
+    std::vector<std::int32_t> point_label(static_cast<std::size_t>(xyz.cols()), -1);
+    for (std::size_t k = 0; k < m; ++k) point_label[pc.indices[k]] = static_cast<std::int32_t>(pc.labels[k]);
     for (std::size_t i = 0; i < point_label.size(); ++i) {
-      const int c = point_label[i];
-      if (c >= 0 && static_cast<int>(sizes[c]) >= params.min_blob_points) blobs[c].push_back(static_cast<int>(i));
+      const std::int32_t c = point_label[i];
+      if (c >= 0 && kept(c)) blobs[c].push_back(static_cast<int>(i));
     }
   } else {
-    for (std::size_t leaf = 0; leaf < label.size(); ++leaf) {
-      if (static_cast<int>(sizes[label[leaf]]) < params.min_blob_points) continue;
-      blobs[label[leaf]].insert(blobs[label[leaf]].end(), tree.LeafPointsBegin(leaf), tree.LeafPointsEnd(leaf));
+    for (std::size_t k = 0; k < m; ++k) {
+      if (kept(pc.labels[k])) blobs[pc.labels[k]].push_back(pc.indices[k]);
     }
     for (auto& blob : blobs) std::sort(blob.begin(), blob.end());
   }
-  for (int c = 0; c < components; ++c) {
+  for (std::size_t c = 0; c < components; ++c) {
     auto& blob = blobs[c];
-    if (static_cast<int>(sizes[c]) < params.min_blob_points) {
+    if (!kept(c)) {
       ++out->dropped_small;
       continue;
     }
@@ -121,7 +91,7 @@ void SegmentAtLeaf(const Eigen::Matrix3Xf& xyz, const std::vector<int>* subset,
       if (out->blobs.size() - before != 1) ++out->refined;
       continue;
     }
-    if (static_cast<int>(blob.size()) > params.max_blob_points) {
+    if (blob.size() > static_cast<std::size_t>(params.max_blob_points)) {
       ++out->dropped_large;
       continue;
     }

@@ -12,9 +12,12 @@ namespace romo::mapping::internal {
 FinitePoints GatherFinite(const Eigen::Matrix3Xf& xyz, const std::vector<int>* subset) {
   FinitePoints out;
   const std::size_t n = subset ? subset->size() : static_cast<std::size_t>(xyz.cols());
-  out.indices.reserve(n);
-  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
-  Eigen::Vector3f hi = -lo;
+  out.indices.resize(n);
+  int* kept = out.indices.data();
+  std::size_t count = 0;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  float lo_x = kInf, lo_y = kInf, lo_z = kInf, hi_x = -kInf, hi_y = -kInf, hi_z = -kInf;
+  const float* p = xyz.data();
   for (std::size_t k = 0; k < n; ++k) {
     const int i = subset ? (*subset)[k] : static_cast<int>(k);
     if (subset && (i < 0 || i >= xyz.cols())) {
@@ -22,18 +25,23 @@ FinitePoints GatherFinite(const Eigen::Matrix3Xf& xyz, const std::vector<int>* s
       msg << "point subset index " << i << " out of range for a cloud of " << xyz.cols() << " points";
       Fail(msg.str());
     }
-    const float x = xyz(0, i), y = xyz(1, i), z = xyz(2, i);
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-      ++out.skipped_non_finite;
-      continue;
-    }
-    out.indices.push_back(i);
-    lo = lo.cwiseMin(Eigen::Vector3f(x, y, z));
-    hi = hi.cwiseMax(Eigen::Vector3f(x, y, z));
+    const float* q = p + 3 * static_cast<std::size_t>(i);
+    const float x = q[0], y = q[1], z = q[2];
+    // v - v is 0 for finite v and NaN for NaN or +-inf: one test for all three.
+    if (!((x - x) + (y - y) + (z - z) == 0.f)) continue;
+    kept[count++] = i;
+    lo_x = std::min(lo_x, x);
+    lo_y = std::min(lo_y, y);
+    lo_z = std::min(lo_z, z);
+    hi_x = std::max(hi_x, x);
+    hi_y = std::max(hi_y, y);
+    hi_z = std::max(hi_z, z);
   }
-  if (!out.indices.empty()) {
-    out.lo = lo;
-    out.hi = hi;
+  out.indices.resize(count);
+  out.skipped_non_finite = n - count;
+  if (count > 0) {
+    out.lo = Eigen::Vector3f(lo_x, lo_y, lo_z);
+    out.hi = Eigen::Vector3f(hi_x, hi_y, hi_z);
   }
   return out;
 }

@@ -1,4 +1,6 @@
+#include <cmath>
 #include <limits>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -150,6 +152,103 @@ TEST(SegmentationTest, BadInputGivesErrorsOrEmptyResults) {
   params.min_blob_points = 1;
   const std::vector<int> bad_subset{3};
   EXPECT_THROW(SegmentBlobs(one, params, &bad_subset), romo::Error);
+}
+
+/// Random clusters, chains and stray points of an awkward count, some exactly on voxel faces, a few
+/// non-finite; centred at @p offset (negative coordinates exercise the snapped origin).
+Eigen::Matrix3Xf RandomCloud(std::uint64_t seed, int n, float leaf_m, const Eigen::Vector3f& offset) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> uni(-1.f, 1.f);
+  std::normal_distribution<float> gauss(0.f, 1.f);
+  std::uniform_int_distribution<int> kind(0, 9);
+  Eigen::Matrix3Xf xyz(3, n);
+  Eigen::Vector3f centre = offset;
+  for (int i = 0; i < n; ++i) {
+    if (i % 97 == 0) centre = offset + Eigen::Vector3f(3.f * uni(rng), 2.f * uni(rng), 1.f * uni(rng));
+    const int k = kind(rng);
+    Eigen::Vector3f p;
+    if (k < 6) {
+      p = centre + 0.15f * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng));
+    } else if (k < 8) {
+      p = centre + Eigen::Vector3f(uni(rng), 0.f, 0.f) * 0.8f;  // chain along x
+    } else if (k < 9) {
+      p = offset + Eigen::Vector3f(3.f * uni(rng), 2.f * uni(rng), 1.f * uni(rng));  // stray
+    } else {
+      // On a voxel face: where floor() decides which leaf a point belongs to.
+      p = (centre / leaf_m).array().round().matrix() * leaf_m;
+    }
+    xyz.col(i) = p;
+  }
+  for (int i = 5; i < n; i += 211) xyz(i % 3, i) = i % 2 ? std::numeric_limits<float>::quiet_NaN() : -INFINITY;
+  return xyz;
+}
+
+void ExpectSameSegmentation(const Segmentation& a, const Segmentation& b) {
+  EXPECT_EQ(a.blobs, b.blobs);
+  EXPECT_EQ(a.occupied_leaves, b.occupied_leaves);
+  EXPECT_EQ(a.dropped_small, b.dropped_small);
+  EXPECT_EQ(a.dropped_large, b.dropped_large);
+  EXPECT_EQ(a.refined, b.refined);
+  EXPECT_EQ(a.skipped_non_finite, b.skipped_non_finite);
+}
+
+TEST(SegmentationTest, DenseGridMatchesOctreeReferenceOnRandomClouds) {
+  // A few-metre extent at these leaves is a grid far under 1 MiB: the default always takes the
+  // dense path; dense_grid_max_bytes = 0 forces the octree-hash reference.
+  std::size_t compared_blobs = 0, refined = 0, dropped_small = 0, dropped_large = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const float leaf_m = 0.05f + 0.037f * static_cast<float>(seed);
+    const int n = 1001 + 1777 * static_cast<int>(seed);
+    const Eigen::Vector3f offset(seed % 2 ? -7.3f : 2.1f, seed % 3 ? 0.45f : -12.f, -0.9f);
+    const Eigen::Matrix3Xf xyz = RandomCloud(seed, n, leaf_m, offset);
+    SegmentationParams fast;
+    fast.leaf_size_m = leaf_m;
+    fast.min_blob_points = 1 + static_cast<int>(seed % 4) * 3;
+    fast.max_blob_points = seed % 2 ? std::numeric_limits<int>::max() : n / 3;
+    if (seed >= 4) {
+      fast.max_object_extent_m = 1.5f;  // refinement runs on blob subsets
+      fast.max_refine_levels = static_cast<int>(seed) - 3;
+    }
+    SegmentationParams reference = fast;
+    reference.dense_grid_max_bytes = 0;
+    const Segmentation a = SegmentBlobs(xyz, fast);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    ExpectSameSegmentation(a, SegmentBlobs(xyz, reference));
+    // And on a subset given out of order.
+    std::vector<int> subset;
+    for (int i = n - 1; i >= 0; i -= 2) subset.push_back(i);
+    ExpectSameSegmentation(SegmentBlobs(xyz, fast, &subset), SegmentBlobs(xyz, reference, &subset));
+    compared_blobs += a.blobs.size();
+    refined += a.refined;
+    dropped_small += a.dropped_small;
+    dropped_large += a.dropped_large;
+  }
+  // The clouds really do exercise many blobs, refinement and both size limits.
+  EXPECT_GT(compared_blobs, 30u);
+  EXPECT_GT(refined, 0u);
+  EXPECT_GT(dropped_small, 0u);
+  EXPECT_GT(dropped_large, 0u);
+}
+
+TEST(SegmentationTest, WideSparseExtentFallsBackToTheOctreeWithTheSameResult) {
+  // Two small clumps 1.5 km apart at a 2 cm leaf: a dense grid would need ~10^16 cells.
+  Eigen::Matrix3Xf xyz(3, 8);
+  for (int i = 0; i < 4; ++i) {
+    xyz.col(i) = Eigen::Vector3f(0.01f * static_cast<float>(i), 0.f, 0.f);
+    xyz.col(4 + i) = Eigen::Vector3f(1500.f, 1500.f + 0.01f * static_cast<float>(i), 1500.f);
+  }
+  SegmentationParams params;
+  params.leaf_size_m = 0.02f;
+  params.min_blob_points = 1;
+  const Segmentation seg = SegmentBlobs(xyz, params);
+  ASSERT_EQ(seg.blobs.size(), 2u);
+  EXPECT_EQ(seg.blobs[0], (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(seg.blobs[1], (std::vector<int>{4, 5, 6, 7}));
+  // A tight budget sends even a small cloud through the octree, with the same answer.
+  const SyntheticScene scene = MakeParkingScene(20000, 3);
+  SegmentationParams tight;
+  tight.dense_grid_max_bytes = 1024;
+  ExpectSameSegmentation(SegmentBlobs(scene.cloud.xyz, tight), SegmentBlobs(scene.cloud.xyz, SegmentationParams{}));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
-/// Connected components over occupied octree leaves by depth-first search (26-neighbourhood),
-/// dissertation 3.2 / Fig. 3.8. Works on a cloud in any frame (vehicle or indoor camera).
+/// Connected components over occupied voxels (octree leaves) by depth-first search
+/// (26-neighbourhood), dissertation 3.2 / Fig. 3.8. A dense bit grid over the cloud's bounding box
+/// when it fits dense_grid_max_bytes, else the octree; both give the same blobs. Works on a cloud in any frame (vehicle or indoor camera).
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -23,6 +24,10 @@ struct SegmentationParams {
   float refine_factor = 0.5f;
   /// How many times a blob may be refined.
   int max_refine_levels = 1;
+  /// Memory (bytes) the dense voxel grid over the cloud's bounding box may take (about 5/16 byte
+  /// per cell); a larger or very sparse extent is labelled through the octree instead, with the
+  /// same result. 0 always uses the octree.
+  std::size_t dense_grid_max_bytes = std::size_t{64} << 20;
 
   /// @throws romo::Error naming the field and value when a field is out of range.
   void Validate() const;
