@@ -154,4 +154,16 @@ std::optional<RigidMotion> EstimateIndependentMotion(const MatchedPoints3D& matc
   return Ransac(matches, linking, params);
 }
 
+std::optional<IndependentMotion> EstimateIndependentMotionIcp(
+    const MatchedPoints3D& matches, const RigidMotion& ego, const std::vector<char>& in_blob_k,
+    const std::vector<char>& in_blob_k1, const Eigen::Matrix3Xd& blob_k, const Eigen::Matrix3Xd& blob_k1,
+    const EgoMotionParams& params, const IcpParams& icp_params) {
+  icp_params.Validate();
+  auto flows = EstimateIndependentMotion(matches, ego, in_blob_k, in_blob_k1, params);
+  if (!flows) return std::nullopt;
+  auto icp = AlignIcp(blob_k, blob_k1, flows->T_2_1, icp_params);
+  if (!icp) return std::nullopt;
+  return IndependentMotion{std::move(*flows), *icp};
+}
+
 }  // namespace romo::mapping

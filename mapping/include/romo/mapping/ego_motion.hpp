@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "romo/mapping/icp.hpp"
+
 namespace romo::mapping {
 
 /// Column l of p1 (frame k) matches column l of p2 (frame k+1); cov1/cov2 their 3x3 covariances.
@@ -62,5 +64,21 @@ std::optional<RigidMotion> EstimateIndependentMotion(const MatchedPoints3D& matc
                                                      const std::vector<char>& in_blob_k,
                                                      const std::vector<char>& in_blob_k1,
                                                      const EgoMotionParams& params);
+
+struct IndependentMotion {
+  RigidMotion flows;  ///< from the outlier flows linking the blobs (coarse)
+  IcpResult icp;      ///< refined on the blobs' points, started from flows.T_2_1
+  /// The refined transform (frame-k object points into frame k+1): icp.T_target_source.
+  const Eigen::Isometry3d& T_2_1() const { return icp.T_target_source; }
+};
+
+/// An object's independent motion: EstimateIndependentMotion on the outlier flows that connect
+/// the stored blob (points @p blob_k, frame k) to the new one (@p blob_k1, frame k+1), refined by
+/// point-to-point ICP of blob_k onto blob_k1. nullopt when too few flows link the blobs or ICP
+/// finds too few pairs.
+std::optional<IndependentMotion> EstimateIndependentMotionIcp(
+    const MatchedPoints3D& matches, const RigidMotion& ego, const std::vector<char>& in_blob_k,
+    const std::vector<char>& in_blob_k1, const Eigen::Matrix3Xd& blob_k, const Eigen::Matrix3Xd& blob_k1,
+    const EgoMotionParams& params, const IcpParams& icp_params);
 
 }  // namespace romo::mapping
