@@ -78,6 +78,15 @@ cv::Mat ReadMat(const cv::FileNode& parent, const char* key, const std::string& 
       }
       if (!values.empty()) mat = cv::Mat(values, true).reshape(1, 1);
     } else if (node.isMap()) {
+      // OpenCV allocates rows x cols before it counts the data (a one-line corrupt size asked
+      // for 48 GB): the declared size must not exceed the numbers given.
+      const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+      if (!rows.isInt() || !cols.isInt() || !data.isSeq() || static_cast<int>(rows) < 0 ||
+          static_cast<int>(cols) < 0 ||
+          static_cast<double>(static_cast<int>(rows)) * static_cast<int>(cols) >
+              static_cast<double>(data.size())) {
+        FieldError(origin, field, "opencv-matrix rows x cols do not match its data");
+      }
       node >> mat;
     }
   } catch (const cv::Exception& e) {
@@ -290,6 +299,8 @@ Calibration Calibration::Load(const std::string& path) {
     if (!fs.open(path, cv::FileStorage::READ)) Fail(path + ": cannot open calibration file");
   } catch (const cv::Exception& e) {
     Fail(path + ": not a valid YAML calibration file: " + e.err);
+  } catch (const std::exception& e) {  // OpenCV's parser also throws std::length_error
+    Fail(path + ": not a valid YAML calibration file: " + e.what());
   }
   return Parse(fs, path);
 }
@@ -303,6 +314,8 @@ Calibration Calibration::FromYaml(const std::string& yaml_text, const std::strin
     }
   } catch (const cv::Exception& e) {
     Fail(origin + ": not a valid YAML calibration: " + e.err);
+  } catch (const std::exception& e) {  // OpenCV's parser also throws std::length_error
+    Fail(origin + ": not a valid YAML calibration: " + e.what());
   }
   return Parse(fs, origin);
 }

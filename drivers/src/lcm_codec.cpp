@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/lcm_walker.hpp"
 #include "romo_lcm/calibration_t.hpp"
 #include "romo_lcm/gnss_fix_t.hpp"
 #include "romo_lcm/rgbd_frame_t.hpp"
@@ -30,6 +31,25 @@ std::vector<std::uint8_t> Encode(const Msg& msg) {
   const int n = msg.encode(out.data(), 0, static_cast<int>(out.size()));
   ROMO_DEMAND(n == static_cast<int>(out.size()));
   return out;
+}
+
+// image_t: stamp_ns, sequence, camera_id, width, height, stride, pixel_format, encoding, size,
+// data[size].
+bool WalkImage(LcmWalker& w) {
+  return w.Skip(8 + 8) && w.String("camera_id") && w.Skip(4 + 4 + 4 + 1 + 1) &&
+         w.FixedArray(1, "size");
+}
+
+// stereo_frame_t / rgbd_frame_t: the hash, @p fixed_bytes of fixed fields, then two image_t.
+// A message of the type whose image sizes do not fit its bytes is rejected before the generated
+// decoder allocates them (a 60-byte message could ask for 2 x 2 GB).
+void CheckImageCounts(const std::vector<std::uint8_t>& data, std::int64_t hash,
+                      std::size_t fixed_bytes, const char* type, const std::string& origin) {
+  if (!LcmHashMatches(data.data(), data.size(), hash)) return;  // Decode names the wrong type
+  LcmWalker w(data.data(), data.size());
+  if (!(w.Skip(8 + fixed_bytes) && WalkImage(w) && WalkImage(w))) {
+    Fail(origin + ": " + w.Reason(std::string("romo_lcm.") + type));
+  }
 }
 
 template <typename Msg>
@@ -239,6 +259,7 @@ std::vector<std::uint8_t> EncodeCalibration(const std::string& yaml, std::int64_
 
 StereoFrame DecodeStereo(const std::vector<std::uint8_t>& data, const std::string& origin,
                          std::int64_t* set_stamp_ns, std::uint64_t* set_sequence) {
+  CheckImageCounts(data, romo_lcm::stereo_frame_t::getHash(), 8 + 8 + 4, "stereo_frame_t", origin);
   const auto msg = Decode<romo_lcm::stereo_frame_t>(data, origin);
   StereoFrame frame;
   frame.rig_id = msg.rig_id;
@@ -251,6 +272,7 @@ StereoFrame DecodeStereo(const std::vector<std::uint8_t>& data, const std::strin
 
 RgbdFrame DecodeRgbd(const std::vector<std::uint8_t>& data, const std::string& origin,
                      std::uint64_t* set_sequence) {
+  CheckImageCounts(data, romo_lcm::rgbd_frame_t::getHash(), 8 + 8 + 8, "rgbd_frame_t", origin);
   const auto msg = Decode<romo_lcm::rgbd_frame_t>(data, origin);
   RgbdFrame frame;
   CameraFrame rgb = DecodeImage(msg.rgb, origin + " rgb");
@@ -342,6 +364,15 @@ ReadResult EventFileReader::Next(LogEvent* event) {
       data_len > kMaxEventBytes) {
     std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
     return ReadResult::kCorrupt;
+  }
+  // The lengths come from the file: one past its end means a cut (or damaged) event, reported
+  // without allocating what the header claims (up to 1 GiB for a few bytes of input).
+  struct stat st {};
+  const std::int64_t size_now =
+      ::fstat(::fileno(file_), &st) == 0 ? static_cast<std::int64_t>(st.st_size) : file_size_;
+  if (offset_ + kEventHeaderBytes + channel_len + data_len > size_now) {
+    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
+    return ReadResult::kTruncated;
   }
   event->channel.resize(static_cast<std::size_t>(channel_len));
   event->data.resize(static_cast<std::size_t>(data_len));

@@ -97,64 +97,69 @@ Atlas Atlas::Parse(const std::string& yaml_text, const std::string& source) {
   }
   if (!root.IsMap()) Bad(source, "<root>", Text(root), "need a mapping with 'classes'");
   Atlas atlas;
-  if (root["min_score"].IsDefined()) {
-    atlas.min_score_ = Number(root, "min_score", "min_score", source);
-    if (!(atlas.min_score_ > 0.0 && atlas.min_score_ < 1.0)) {
-      Bad(source, "min_score", Text(root["min_score"]), "need 0 < min_score < 1");
-    }
-  }
-  const YAML::Node classes = root["classes"];
-  if (!classes.IsSequence() || classes.size() == 0) {
-    Bad(source, "classes", Text(classes), "need a non-empty list of classes");
-  }
-  for (std::size_t i = 0; i < classes.size(); ++i) {
-    const YAML::Node c = classes[i];
-    const std::string prefix = "classes[" + std::to_string(i) + "]";
-    if (!c.IsMap()) Bad(source, prefix, Text(c), "need a mapping");
-    ObjectClass oc;
-    const YAML::Node name = c["name"];
-    if (!name.IsScalar() || name.Scalar().empty()) Bad(source, prefix + ".name", Text(name), "need a name");
-    oc.name = name.Scalar();
-    if (atlas.Find(oc.name) >= 0) Bad(source, prefix + ".name", oc.name, "duplicate class");
-    const std::string p = prefix + " (" + oc.name + ")";
-    const int priors = (c["length_m"].IsDefined() ? 1 : 0) + (c["width_m"].IsDefined() ? 1 : 0) +
-                       (c["height_m"].IsDefined() ? 1 : 0);
-    if (priors != 0 && priors != 3) {
-      Bad(source, p, Text(c), "give all of length_m, width_m, height_m or none");
-    }
-    oc.has_priors = priors == 3;
-    if (oc.has_priors) {
-      oc.length = ReadPrior(c, "length_m", p, source);
-      oc.width = ReadPrior(c, "width_m", p, source);
-      oc.height = ReadPrior(c, "height_m", p, source);
-      if (oc.width.mean_m > oc.length.mean_m) {
-        Bad(source, p + ".width_m.mean", Text(c["width_m"]["mean"]),
-            "width must not exceed length (length is the longer footprint side)");
+  // yaml-cpp's accessors throw (e.g. YAML::InvalidNode on some malformed maps); name the file.
+  try {
+    if (root["min_score"].IsDefined()) {
+      atlas.min_score_ = Number(root, "min_score", "min_score", source);
+      if (!(atlas.min_score_ > 0.0 && atlas.min_score_ < 1.0)) {
+        Bad(source, "min_score", Text(root["min_score"]), "need 0 < min_score < 1");
       }
     }
-    const YAML::Node attr = c["attributes"];
-    if (attr.IsDefined()) {
-      if (!attr.IsMap()) Bad(source, p + ".attributes", Text(attr), "need a mapping");
-      const std::string a = p + ".attributes";
-      oc.movable = Flag(attr, "movable", oc.movable, a + ".movable", source);
-      oc.predict_path = Flag(attr, "predict_path", oc.predict_path, a + ".predict_path", source);
-      if (attr["max_speed_mps"].IsDefined()) {
-        oc.max_speed_mps = Number(attr, "max_speed_mps", a + ".max_speed_mps", source);
-        if (!(oc.max_speed_mps > 0.0)) Bad(source, a + ".max_speed_mps", Text(attr["max_speed_mps"]), "need > 0");
+    const YAML::Node classes = root["classes"];
+    if (!classes.IsSequence() || classes.size() == 0) {
+      Bad(source, "classes", Text(classes), "need a non-empty list of classes");
+    }
+    for (std::size_t i = 0; i < classes.size(); ++i) {
+      const YAML::Node c = classes[i];
+      const std::string prefix = "classes[" + std::to_string(i) + "]";
+      if (!c.IsMap()) Bad(source, prefix, Text(c), "need a mapping");
+      ObjectClass oc;
+      const YAML::Node name = c["name"];
+      if (!name.IsScalar() || name.Scalar().empty()) Bad(source, prefix + ".name", Text(name), "need a name");
+      oc.name = name.Scalar();
+      if (atlas.Find(oc.name) >= 0) Bad(source, prefix + ".name", oc.name, "duplicate class");
+      const std::string p = prefix + " (" + oc.name + ")";
+      const int priors = (c["length_m"].IsDefined() ? 1 : 0) + (c["width_m"].IsDefined() ? 1 : 0) +
+                         (c["height_m"].IsDefined() ? 1 : 0);
+      if (priors != 0 && priors != 3) {
+        Bad(source, p, Text(c), "give all of length_m, width_m, height_m or none");
       }
-      if (attr["max_occlusion_s"].IsDefined()) {
-        oc.max_occlusion_s = Number(attr, "max_occlusion_s", a + ".max_occlusion_s", source);
-        if (!(oc.max_occlusion_s >= 0.0)) {
-          Bad(source, a + ".max_occlusion_s", Text(attr["max_occlusion_s"]), "need >= 0");
+      oc.has_priors = priors == 3;
+      if (oc.has_priors) {
+        oc.length = ReadPrior(c, "length_m", p, source);
+        oc.width = ReadPrior(c, "width_m", p, source);
+        oc.height = ReadPrior(c, "height_m", p, source);
+        if (oc.width.mean_m > oc.length.mean_m) {
+          Bad(source, p + ".width_m.mean", Text(c["width_m"]["mean"]),
+              "width must not exceed length (length is the longer footprint side)");
         }
       }
+      const YAML::Node attr = c["attributes"];
+      if (attr.IsDefined()) {
+        if (!attr.IsMap()) Bad(source, p + ".attributes", Text(attr), "need a mapping");
+        const std::string a = p + ".attributes";
+        oc.movable = Flag(attr, "movable", oc.movable, a + ".movable", source);
+        oc.predict_path = Flag(attr, "predict_path", oc.predict_path, a + ".predict_path", source);
+        if (attr["max_speed_mps"].IsDefined()) {
+          oc.max_speed_mps = Number(attr, "max_speed_mps", a + ".max_speed_mps", source);
+          if (!(oc.max_speed_mps > 0.0)) Bad(source, a + ".max_speed_mps", Text(attr["max_speed_mps"]), "need > 0");
+        }
+        if (attr["max_occlusion_s"].IsDefined()) {
+          oc.max_occlusion_s = Number(attr, "max_occlusion_s", a + ".max_occlusion_s", source);
+          if (!(oc.max_occlusion_s >= 0.0)) {
+            Bad(source, a + ".max_occlusion_s", Text(attr["max_occlusion_s"]), "need >= 0");
+          }
+        }
+      }
+      atlas.classes_.push_back(oc);
     }
-    atlas.classes_.push_back(oc);
-  }
-  atlas.unknown_ = atlas.Find("unknown");
-  if (atlas.unknown_ < 0) Bad(source, "classes", "", "need a class named 'unknown' (the fallback)");
-  if (atlas.classes_[static_cast<std::size_t>(atlas.unknown_)].has_priors) {
-    Bad(source, "classes (unknown)", "", "the fallback class 'unknown' must have no size priors");
+    atlas.unknown_ = atlas.Find("unknown");
+    if (atlas.unknown_ < 0) Bad(source, "classes", "", "need a class named 'unknown' (the fallback)");
+    if (atlas.classes_[static_cast<std::size_t>(atlas.unknown_)].has_priors) {
+      Bad(source, "classes (unknown)", "", "the fallback class 'unknown' must have no size priors");
+    }
+  } catch (const YAML::Exception& e) {
+    Fail("atlas '" + source + "': malformed YAML: " + e.what());
   }
   return atlas;
 }

@@ -1,8 +1,10 @@
 // LCM adapter for prediction logs: the generated romo_lcm types stay in this file.
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/lcm_walker.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo_lcm/pedestrian_predictions_t.hpp"
 
@@ -88,10 +90,40 @@ std::vector<std::uint8_t> EncodePedestrianPredictions(
   return bytes;
 }
 
+namespace {
+
+// LCM's generated decoder sizes arrays from the counts before checking the bytes (a negative count
+// throws std::length_error, a large one allocates gigabytes), so the counts are walked first.
+// Minimum encoded sizes: pedestrian_prediction_t 143 bytes (strings of at least their NUL),
+// predicted_point_t 17 doubles.
+void CheckPredictionCounts(const void* data, std::size_t size) {
+  if (!drivers::LcmHashMatches(data, size, romo_lcm::pedestrian_predictions_t::getHash())) return;
+  drivers::LcmWalker w(data, size);
+  std::int32_t n = 0;
+  bool fits = w.Skip(8 + 8 + 8) && w.Count(143, &n, "num_predictions");
+  for (std::int32_t i = 0; fits && i < n; ++i) {
+    fits = w.Skip(8 + 4) && w.String("track_state") && w.Skip(4 + 1) && w.String("predictor") &&
+           w.Skip(8 + 2 * 8 + 3 * 8 + 3 * 8 + 2 * 8 + 3 * 8) && w.FixedArray(17 * 8, "num_points");
+  }
+  if (!fits) Fail(w.Reason("romo_lcm.pedestrian_predictions_t"));
+}
+
+bool DecodeInto(const void* data, std::size_t size, romo_lcm::pedestrian_predictions_t* msg) {
+  if (data == nullptr || size > static_cast<std::size_t>(std::numeric_limits<int>::max())) return false;
+  try {
+    return msg->decode(data, 0, static_cast<int>(size)) >= 0;
+  } catch (const std::exception&) {  // std::length_error from a count the walk let through
+    return false;
+  }
+}
+
+}  // namespace
+
 std::vector<PedestrianPrediction> DecodePedestrianPredictions(const void* data, std::size_t size,
                                                               std::int64_t* frame_sequence) {
+  CheckPredictionCounts(data, size);
   romo_lcm::pedestrian_predictions_t msg;
-  if (data == nullptr || msg.decode(data, 0, static_cast<int>(size)) < 0) {
+  if (!DecodeInto(data, size, &msg)) {
     Fail("romo_lcm.pedestrian_predictions_t: cannot decode " + std::to_string(size) +
          " bytes (wrong type or truncated)");
   }

@@ -161,6 +161,8 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
     rc = reader.readHeader(path, header, origin, orientation, version, data_type, data_idx);
   } catch (const pcl::PCLException& e) {
     Fail("PCD file '" + path + "' has a corrupt header: " + e.what());
+  } catch (const std::exception& e) {  // PCL 1.13 also throws std::out_of_range (vector::at)
+    Fail("PCD file '" + path + "' has a corrupt header: " + e.what());
   }
   if (rc < 0) Fail("PCD file '" + path + "' has a corrupt header (PCL error " + std::to_string(rc) + ")");
   if (header.fields.empty()) Fail("PCD file '" + path + "' has no FIELDS: not a PCD file?");
@@ -197,6 +199,8 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
   try {
     rc = reader.read(path, in);
   } catch (const pcl::PCLException& e) {
+    Fail("PCD file '" + path + "' is corrupt: " + e.what());
+  } catch (const std::exception& e) {  // as for the header
     Fail("PCD file '" + path + "' is corrupt: " + e.what());
   }
   if (rc < 0) Fail("PCD file '" + path + "' is corrupt or unreadable (PCL error " + std::to_string(rc) + ")");

@@ -124,5 +124,23 @@ TEST(PredictionLogTest, LcmRoundTripKeepsEveryField) {
   EXPECT_THROW(DecodePedestrianPredictions(junk.data(), junk.size()), romo::Error);
 }
 
+TEST(PredictionLogTest, CorruptCountIsRejectedBeforeAllocating) {
+  // An empty frame ends with num_predictions = 0; 2^31 - 1 of them would make LCM's decoder
+  // allocate ~400 GB for a 28-byte message, -1 would make it throw std::length_error.
+  std::vector<std::uint8_t> bytes = EncodePedestrianPredictions(1, 2, {});
+  ASSERT_EQ(bytes.size(), 28u);
+  bytes[24] = 0x7f;
+  bytes[25] = bytes[26] = bytes[27] = 0xff;
+  try {
+    DecodePedestrianPredictions(bytes.data(), bytes.size());
+    FAIL() << "a corrupt count was accepted";
+  } catch (const romo::Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "romo_lcm.pedestrian_predictions_t.num_predictions = 2147483647 does not fit a 28-byte message");
+  }
+  bytes[24] = 0xff;
+  EXPECT_THROW(DecodePedestrianPredictions(bytes.data(), bytes.size()), romo::Error);
+}
+
 }  // namespace
 }  // namespace romo::objects

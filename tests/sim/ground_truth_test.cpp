@@ -133,5 +133,33 @@ TEST(GroundTruthTest, GnssFixFollowsTheGeodeticOrigin) {
   }
 }
 
+TEST(GroundTruthTest, CorruptCountsAreRejectedBeforeAllocating) {
+  // No objects and no bays: the message ends with num_objects = 0 and num_bays = 0.
+  GroundTruth truth;
+  truth.scene = "parking";
+  std::vector<std::uint8_t> bytes = Encode(truth);
+  ASSERT_GE(bytes.size(), 8u);
+  const std::size_t num_objects_at = bytes.size() - 8;
+  // 2^31 - 1 objects would make LCM's decoder allocate ~400 GB for a ~300-byte message.
+  bytes[num_objects_at] = 0x7f;
+  bytes[num_objects_at + 1] = bytes[num_objects_at + 2] = bytes[num_objects_at + 3] = 0xff;
+  try {
+    DecodeGroundTruth(bytes.data(), bytes.size(), "gt");
+    FAIL() << "a corrupt object count was accepted";
+  } catch (const romo::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gt: romo_lcm.ground_truth_t.num_objects = 2147483647 does not fit"),
+              std::string::npos)
+        << e.what();
+  }
+  // -1: the generated decoder would throw std::length_error instead of romo::Error.
+  bytes[num_objects_at] = 0xff;
+  EXPECT_THROW(DecodeGroundTruth(bytes.data(), bytes.size(), "gt"), romo::Error);
+  GtDepth depth;
+  depth.width = depth.height = 0;
+  std::vector<std::uint8_t> depth_bytes = Encode(depth);
+  depth_bytes[depth_bytes.size() - 1] = 100;  // size = 100 pixels in a message that holds none
+  EXPECT_THROW(DecodeGtDepth(depth_bytes.data(), depth_bytes.size(), "gt"), romo::Error);
+}
+
 }  // namespace
 }  // namespace romo::sim

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/lcm_walker.hpp"
 #include "romo_lcm/ground_truth_t.hpp"
 #include "romo_lcm/gt_depth_t.hpp"
 
@@ -68,6 +70,47 @@ const GtBox* GroundTruth::Find(int id) const {
   return nullptr;
 }
 
+namespace {
+
+// LCM's generated decoders allocate arrays from the counts before checking the bytes, so the
+// counts are walked first (drivers/lcm_walker.hpp), from the 8-byte type hash on. Minimum
+// encoded sizes: gt_object_t 89 bytes (id, class_name of at least its NUL, 10 doubles),
+// gt_bay_t 61, one gt_depth_t pixel 12.
+bool WalkGroundTruth(drivers::LcmWalker& w) {
+  std::int32_t objects = 0;
+  if (!(w.Skip(8 + 8 + 8) && w.String("scene") && w.Skip(8 + 3 * 8 + 3 * 8 + 4 * 8 + 8 + 8 + 3 * 8) &&
+        w.String("ego_phase") && w.Skip(3 * 8) && w.Count(4 + 5 + 10 * 8, &objects, "num_objects"))) {
+    return false;
+  }
+  for (std::int32_t i = 0; i < objects; ++i) {
+    if (!(w.Skip(4) && w.String("objects.class_name") && w.Skip(10 * 8))) return false;
+  }
+  return w.FixedArray(4 + 6 * 8 + 1 + 4 + 4, "num_bays");
+}
+
+bool WalkGtDepth(drivers::LcmWalker& w) {
+  return w.Skip(8 + 8 + 8 + 4 + 4 + 4) && w.FixedArray(4 + 4 + 2 + 2, "size");
+}
+
+void CheckCounts(const void* data, std::size_t size, std::int64_t hash,
+                 bool (*walk)(drivers::LcmWalker&), const char* type, const std::string& origin) {
+  if (!drivers::LcmHashMatches(data, size, hash)) return;  // the decoder names the wrong type
+  drivers::LcmWalker w(data, size);
+  if (!walk(w)) Fail(origin + ": " + w.Reason(std::string("romo_lcm.") + type));
+}
+
+template <typename Msg>
+bool DecodeInto(const void* data, std::size_t size, Msg* m) {
+  if (data == nullptr || size > static_cast<std::size_t>(std::numeric_limits<int>::max())) return false;
+  try {
+    return m->decode(data, 0, static_cast<int>(size)) >= 0;
+  } catch (const std::exception&) {  // std::length_error from a count the walk let through
+    return false;
+  }
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> Encode(const GroundTruth& t) {
   romo_lcm::ground_truth_t m;
   m.stamp_ns = t.stamp_ns;
@@ -124,8 +167,10 @@ std::vector<std::uint8_t> Encode(const GroundTruth& t) {
 }
 
 GroundTruth DecodeGroundTruth(const void* data, std::size_t size, const std::string& origin) {
+  CheckCounts(data, size, romo_lcm::ground_truth_t::getHash(), WalkGroundTruth, "ground_truth_t",
+              origin);
   romo_lcm::ground_truth_t m;
-  if (m.decode(data, 0, static_cast<int>(size)) < 0) {
+  if (!DecodeInto(data, size, &m)) {
     Fail(origin + ": not a valid romo_lcm.ground_truth_t message (" + std::to_string(size) +
          " bytes)");
   }
@@ -201,8 +246,9 @@ std::vector<std::uint8_t> Encode(const GtDepth& d) {
 }
 
 GtDepth DecodeGtDepth(const void* data, std::size_t size, const std::string& origin) {
+  CheckCounts(data, size, romo_lcm::gt_depth_t::getHash(), WalkGtDepth, "gt_depth_t", origin);
   romo_lcm::gt_depth_t m;
-  if (m.decode(data, 0, static_cast<int>(size)) < 0) {
+  if (!DecodeInto(data, size, &m)) {
     Fail(origin + ": not a valid romo_lcm.gt_depth_t message (" + std::to_string(size) +
          " bytes)");
   }
