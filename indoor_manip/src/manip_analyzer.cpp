@@ -11,6 +11,10 @@ void ManipParams::Validate() const {
   kalman.Validate();
   rotation.Validate();
   thresholds.Validate();
+  location.Validate();
+  scene.Validate();
+  odometry.Validate();
+  icp.Validate();
   if (max_lost_frames < 0) Fail("max_lost_frames must be >= 0, got " + std::to_string(max_lost_frames));
 }
 
@@ -33,6 +37,8 @@ class ManipAnalyzer::Impl {
              std::to_string(params_.hand.min_pixels) + "): not a hand-sized blob");
       }
       kf_.Initialize(blob->centroid_m);
+      scene_ = SegmentSceneObjects(image, k_, plane_, blob->seed, params_.scene);
+      first_image_ = image;
       s.predicted_m = blob->centroid_m;
     } else {
       if (lost_ > params_.max_lost_frames) {
@@ -65,6 +71,7 @@ class ManipAnalyzer::Impl {
       prev_blob_.reset();
     }
     last_t_ = t;
+    last_image_ = image;
     path_.push_back(s);
     return blob;
   }
@@ -94,6 +101,12 @@ class ManipAnalyzer::Impl {
     r.fingerprint = BuildFingerprint(t, c, plane_, params_.encapsulation);
     r.features = ComputeActionFeatures(r.fingerprint.profiles, rotation_);
     r.decision = ClassifyAction(r.features, params_.thresholds);
+    r.locations = FindLocationAreas(r.fingerprint, params_.location);
+    r.scene = scene_;
+    if (params_.object_motions && frames_ > 1) {
+      const SceneGeometry last = SegmentSceneObjects(last_image_, k_, plane_, cv::Point(-1, -1), params_.scene);
+      r.object_motions = EstimateObjectMotions(first_image_, scene_, last_image_, last, k_, params_.odometry, params_.icp);
+    }
     return r;
   }
 
@@ -103,6 +116,8 @@ class ManipAnalyzer::Impl {
   ManipParams params_;
   HandKalmanFilter kf_;
   std::vector<PathSample> path_;
+  SceneGeometry scene_;
+  RgbdImage first_image_, last_image_;
   std::vector<Eigen::Vector3d> rotation_;
   std::optional<HandBlob> prev_blob_;
   RgbdImage prev_image_;

@@ -80,6 +80,22 @@ cv::Mat FingerprintPlot(const ManipResult& r) {
     cv::line(img, ax.Map(p.x_m[i - 1], p.y_m[i - 1]), ax.Map(p.x_m[i], p.y_m[i]),
              cv::Scalar(60 + 150 * f, 30, 150 - 120 * f), 2, cv::LINE_AA);
   }
+  // Location areas (green circles, radius to scale) and transport ends (orange start, red stop).
+  const double px_per_m = ax.area.width / std::max(1e-9, ax.x1 - ax.x0);
+  const auto& loc = r.locations;
+  for (std::size_t a = 0; a < loc.areas.size(); ++a) {
+    const auto& area = loc.areas[a];
+    const cv::Point c = ax.Map(area.centre_xy_m.x(), area.centre_xy_m.y());
+    cv::circle(img, c, std::max(4, static_cast<int>(area.radius_m * px_per_m)), kGreen, 2, cv::LINE_AA);
+    cv::putText(img, "A" + std::to_string(a), c + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5, kGreen, 2);
+  }
+  for (const auto& tr : loc.transports) {
+    const cv::Point a = ax.Map(tr.start_xy_m.x(), tr.start_xy_m.y());
+    const cv::Point b = ax.Map(tr.end_xy_m.x(), tr.end_xy_m.y());
+    cv::arrowedLine(img, a, b, cv::Scalar(0, 140, 255), 1, cv::LINE_AA, 0, 0.05);
+    cv::circle(img, a, 5, cv::Scalar(0, 140, 255), cv::FILLED);
+    cv::circle(img, b, 5, kRed, cv::FILLED);
+  }
   return img;
 }
 
@@ -154,6 +170,27 @@ std::string ManipResultJson(const ManipResult& r) {
   std::ostringstream s;
   s << "{\n  \"label\": \"" << JsonEscape(r.decision.label) << "\",\n  \"evidence\": {\n";
   for (const auto& [name, value] : r.features.Named()) s << "    \"" << name << "\": " << Num(value) << ",\n";
+  s << "    \"location_areas\": [";
+  for (std::size_t i = 0; i < r.locations.areas.size(); ++i) {
+    const auto& a = r.locations.areas[i];
+    s << (i ? ",\n      " : "\n      ") << "{\"id\": " << i << ", \"centre_xy_m\": [" << Num(a.centre_xy_m.x())
+      << ", " << Num(a.centre_xy_m.y()) << "], \"centre_camera_m\": [" << Num(a.centre_camera_m.x())
+      << ", " << Num(a.centre_camera_m.y()) << ", " << Num(a.centre_camera_m.z())
+      << "], \"radius_m\": " << Num(a.radius_m) << ", \"dwell_s\": " << Num(a.dwell_s)
+      << ", \"stays\": " << a.stays << ", \"transport_starts\": " << a.transport_starts
+      << ", \"transport_ends\": " << a.transport_ends << ", \"sources\": [";
+    for (std::size_t k = 0; k < a.sources.size(); ++k) s << (k ? ", " : "") << "\"" << a.sources[k] << "\"";
+    s << "]}";
+  }
+  s << "],\n    \"transports\": [";
+  for (std::size_t i = 0; i < r.locations.transports.size(); ++i) {
+    const auto& t = r.locations.transports[i];
+    s << (i ? ",\n      " : "\n      ") << "{\"from_area\": " << t.from_area << ", \"to_area\": " << t.to_area
+      << ", \"start_xy_m\": [" << Num(t.start_xy_m.x()) << ", " << Num(t.start_xy_m.y())
+      << "], \"end_xy_m\": [" << Num(t.end_xy_m.x()) << ", " << Num(t.end_xy_m.y())
+      << "], \"length_m\": " << Num(t.length_m) << ", \"duration_s\": " << Num(t.duration_s) << "}";
+  }
+  s << "],\n";
   s << "    \"reasons\": [";
   for (std::size_t i = 0; i < r.decision.reasons.size(); ++i) {
     s << (i ? ", " : "") << "\"" << JsonEscape(r.decision.reasons[i]) << "\"";

@@ -1,9 +1,15 @@
 #include "romo/sim_manip/manip_eval.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/core/json.hpp"
 #include "romo/indoor_manip/manip_session.hpp"
 
 namespace romo::sim_manip {
@@ -114,6 +120,79 @@ std::string ConfusionMatrix::ToText() const {
     out += "\n";
   }
   return out;
+}
+
+std::string ConfusionMatrix::ToJson() const {
+  std::ostringstream s;
+  s << "{\n  \"labels\": [";
+  for (std::size_t i = 0; i < labels.size(); ++i) s << (i ? ", " : "") << "\"" << JsonEscape(labels[i]) << "\"";
+  s << "],\n  \"counts\": [";
+  for (std::size_t i = 0; i + 1 < labels.size(); ++i) {  // the "error" row is never a truth
+    s << (i ? ",\n    " : "\n    ") << "[";
+    for (std::size_t j = 0; j < labels.size(); ++j) s << (j ? ", " : "") << counts[i][j];
+    s << "]";
+  }
+  char acc[32];
+  std::snprintf(acc, sizeof(acc), "%.4f", Accuracy());
+  s << "],\n  \"total\": " << Total() << ",\n  \"accuracy\": " << acc << ",\n  \"per_action\": {";
+  for (std::size_t i = 0; i + 1 < labels.size(); ++i) {
+    int runs = 0, predicted = 0;
+    for (std::size_t j = 0; j < labels.size(); ++j) runs += counts[i][j];
+    for (std::size_t t = 0; t + 1 < labels.size(); ++t) predicted += counts[t][i];
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "\"correct\": %d, \"runs\": %d, \"recall\": %.4f, \"precision\": %.4f",
+                  counts[i][i], runs, runs ? double(counts[i][i]) / runs : 0.0,
+                  predicted ? double(counts[i][i]) / predicted : 0.0);
+    s << (i ? ",\n    " : "\n    ") << "\"" << JsonEscape(labels[i]) << "\": {" << buf << "}";
+  }
+  s << "},\n  \"pairs\": [";
+  const auto& names = indoor_manip::ActionNames();
+  for (std::size_t i = 0; i + 1 < names.size(); i += 2) {
+    s << (i ? ", " : "") << "{\"a\": \"" << names[i] << "\", \"b\": \"" << indoor_manip::ActionPartner(names[i])
+      << "\", \"confusions\": " << PairConfusions(names[i]) << "}";
+  }
+  s << "]\n}\n";
+  return s.str();
+}
+
+void WriteConfusionPng(const ConfusionMatrix& m, const std::string& path, const std::string& title) {
+  const int n_rows = static_cast<int>(m.labels.size()) - 1;  // truths
+  const int n_cols = static_cast<int>(m.labels.size());      // predictions incl. "error"
+  constexpr int kCell = 56, kLeft = 120, kTop = 130;
+  cv::Mat img(kTop + n_rows * kCell + 40, kLeft + n_cols * kCell + 20, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::putText(img, title, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  cv::putText(img, "predicted ->", {kLeft, 44}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  for (int j = 0; j < n_cols; ++j) {  // column names written upwards
+    cv::Mat text(kCell, 80, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::putText(text, m.labels[j], {2, kCell / 2 + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    cv::Mat up;
+    cv::rotate(text, up, cv::ROTATE_90_COUNTERCLOCKWISE);
+    up.copyTo(img(cv::Rect(kLeft + j * kCell, kTop - 80, kCell, 80)));
+  }
+  for (int i = 0; i < n_rows; ++i) {
+    int runs = 0;
+    for (int j = 0; j < n_cols; ++j) runs += m.counts[i][j];
+    cv::putText(img, m.labels[i], {6, kTop + i * kCell + kCell / 2 + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    for (int j = 0; j < n_cols; ++j) {
+      const int c = m.counts[i][j];
+      const double f = runs > 0 ? static_cast<double>(c) / runs : 0.0;
+      // Diagonal cells shade green, confusions red; intensity = share of the row.
+      const cv::Scalar colour = i == j ? cv::Scalar(255 - 155 * f, 255 - 40 * f, 255 - 155 * f)
+                                       : cv::Scalar(255 - 200 * f, 255 - 200 * f, 255);
+      const cv::Rect cell(kLeft + j * kCell, kTop + i * kCell, kCell, kCell);
+      cv::rectangle(img, cell, colour, cv::FILLED);
+      cv::rectangle(img, cell, cv::Scalar(180, 180, 180), 1);
+      if (c > 0) {
+        cv::putText(img, std::to_string(c), {cell.x + kCell / 2 - 9, cell.y + kCell / 2 + 6},
+                    cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+      }
+    }
+  }
+  char acc[64];
+  std::snprintf(acc, sizeof(acc), "accuracy %.3f over %d runs", m.Accuracy(), m.Total());
+  cv::putText(img, acc, {10, img.rows - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  if (!cv::imwrite(path, img)) Fail("cannot write confusion matrix picture '" + path + "'");
 }
 
 }  // namespace romo::sim_manip

@@ -55,9 +55,9 @@ SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
   o.action = uri.path;
   for (const auto& [key, value] : uri.query) {
     if (key != "seed" && key != "frames" && key != "width" && key != "height" && key != "fps" &&
-        key != "noise") {
+        key != "noise" && key != "transports") {
       Fail("sim-manip URI '" + uri.ToString() + "': unknown query key '" + key +
-           "' (known: seed, frames, width, height, fps, noise)");
+           "' (known: seed, frames, width, height, fps, noise, transports)");
     }
   }
   if (auto v = uri.GetInt("seed")) {
@@ -69,6 +69,7 @@ SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
   if (auto v = uri.GetInt("height")) o.height_px = static_cast<int>(*v);
   if (auto v = uri.GetDouble("fps")) o.fps = *v;
   if (auto v = uri.GetInt("noise")) o.noise = *v != 0;
+  if (auto v = uri.GetInt("transports")) o.transports = static_cast<int>(*v);
   o.Validate();
   return o;
 }
@@ -84,7 +85,59 @@ void SimManipOptions::Validate() const {
          "x" + std::to_string(height_px));
   }
   if (!(fps >= 1.0 && fps <= 240.0)) Fail("sim-manip: fps must be in [1, 240], got " + std::to_string(fps));
+  if (transports < 0 || transports > 20) {
+    Fail("sim-manip: transports must be in [0, 20], got " + std::to_string(transports));
+  }
+  // Each work segment must last a second at least, besides the 1 s transports.
+  if (transports > 0 && frames < static_cast<int>(std::ceil((2 * transports + 1) * fps))) {
+    Fail("sim-manip: " + std::to_string(transports) + " transports need at least " +
+         std::to_string(static_cast<int>(std::ceil((2 * transports + 1) * fps))) + " frames, got " +
+         std::to_string(frames));
+  }
 }
+
+namespace {
+
+// The action's own path re-timed around transports: work at spot A, carry the hand (lifted,
+// pose frozen) to spot B, work there, back to A, ... Spots are plane offsets (u, v).
+std::vector<internal::HandPose> WithTransports(const std::vector<internal::HandPose>& action, int transports,
+                                               double fps, std::vector<int>* spot_of_frame,
+                                               std::vector<std::pair<int, int>>* transport_frames) {
+  const int n = static_cast<int>(action.size());
+  const Eigen::Vector2d spots[2] = {{0.0, 0.0}, {0.30, -0.05}};  // 30 cm apart, both in view
+  constexpr double kLiftM = 0.12;  // a carried hand clears the table
+  const int tf = static_cast<int>(std::lround(fps));  // 1 s per transport
+  const int work = (n - transports * tf) / (transports + 1);
+  std::vector<internal::HandPose> out(n);
+  spot_of_frame->assign(n, -1);
+  int action_k = 0;  // the action's own clock only runs while working
+  int k = 0;
+  for (int seg = 0; seg <= transports; ++seg) {
+    const int spot = seg % 2;
+    const int len = seg == transports ? n - k : work;
+    for (int i = 0; i < len; ++i, ++k) {
+      out[k] = action[std::min(action_k++, n - 1)];
+      out[k].u_m += spots[spot].x();
+      out[k].v_m += spots[spot].y();
+      (*spot_of_frame)[k] = spot;
+    }
+    if (seg == transports) break;
+    const internal::HandPose held = action[std::min(action_k, n - 1)];
+    const Eigen::Vector2d from = spots[spot], to = spots[1 - spot];
+    transport_frames->push_back({k, k + tf - 1});
+    for (int i = 0; i < tf; ++i, ++k) {
+      const double s = (i + 1.0) / (tf + 1.0);
+      const double e = s * s * (3 - 2 * s);  // eased: hands accelerate and brake
+      out[k] = held;
+      out[k].u_m += from.x() + e * (to.x() - from.x());
+      out[k].v_m += from.y() + e * (to.y() - from.y());
+      out[k].h_m += kLiftM * std::sin(M_PI * s);
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 class SimManipScene::Impl {
  public:
@@ -94,6 +147,10 @@ class SimManipScene::Impl {
     salt_ = o.seed * 0x100000001B3ull ^ action_salt;
     std::mt19937_64 rng(salt_);
     path_ = internal::GenerateHandPath(o.action, rng, o.frames, o.fps);
+    std::vector<int> spot_of_frame(path_.size(), 0);
+    if (o.transports > 0) {
+      path_ = WithTransports(path_, o.transports, o.fps, &spot_of_frame, &truth_.transport_frames);
+    }
     board_ = internal::IsBoardAction(o.action);
 
     // Kinect v1 intrinsics scaled to the image size.
@@ -140,6 +197,16 @@ class SimManipScene::Impl {
     for (const auto& p : path_) {
       truth_.hand_centre_camera_m.push_back(R_C_P * (Eigen::Vector3d(p.u_m, p.v_m, p.h_m) - eye_));
       truth_.hand_yaw_rad.push_back(p.yaw_rad);
+    }
+    for (int spot = 0; spot < (o.transports > 0 ? 2 : 1); ++spot) {
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (std::size_t k = 0; k < path_.size(); ++k) {
+        if (spot_of_frame[k] != spot) continue;
+        mean += Eigen::Vector3d(path_[k].u_m, path_[k].v_m, 0.0);
+        ++count;
+      }
+      truth_.work_area_centres_camera_m.push_back(R_C_P * (mean / count - eye_));
     }
     const Eigen::Vector3d c0 = truth_.hand_centre_camera_m.front();
     truth_.seed_u_px = static_cast<int>(std::lround(K_(0, 0) * c0.x() / c0.z() + K_(0, 2)));

@@ -14,7 +14,9 @@
 #include "romo/indoor_manip/hand_rotation.hpp"
 #include "romo/indoor_manip/hand_segmentation.hpp"
 #include "romo/indoor_manip/interaction_plane.hpp"
+#include "romo/indoor_manip/location_areas.hpp"
 #include "romo/indoor_manip/rgbd_image.hpp"
+#include "romo/indoor_manip/scene_objects.hpp"
 
 namespace romo::indoor_manip {
 
@@ -23,6 +25,13 @@ struct ManipParams {
   HandKalmanParams kalman;
   RotationParams rotation;
   ActionThresholds thresholds;
+  LocationParams location;
+  SceneObjectParams scene;
+  /// Independent motions of the scene's objects between the first and the last frame (feature
+  /// flows + ICP); off: none are estimated.
+  bool object_motions = true;
+  OdometryParams odometry;
+  mapping::IcpParams icp;
   Encapsulation encapsulation = Encapsulation::kPln;
   /// Frames after which a lost hand ends tracking (the path keeps the predictions until then).
   int max_lost_frames = 15;
@@ -45,6 +54,12 @@ struct ManipResult {
   std::vector<Eigen::Vector3d> rotation_steps_rad;  ///< per frame pair, hand frame x, y, z
   ActionFeatures features;
   ActionDecision decision;
+  /// Location areas on the plane (stays and ends of transport paths) with the transports.
+  LocationAnalysis locations;
+  /// The geometric layer on the first frame: plane inliers, blobs (octree DFS) with PCA boxes.
+  SceneGeometry scene;
+  /// Independent motions of the first frame's objects by the last frame.
+  std::vector<ObjectMotion> object_motions;
   InteractionPlane plane;
   int frames = 0;
   int frames_without_hand = 0;

@@ -27,6 +27,14 @@ struct ConfusionMatrix {
   int PairConfusions(const std::string& action) const;
   /// Fixed-width table, rows = truth, columns = predicted.
   std::string ToText() const;
+  /// {"labels": [...], "counts": [[...], ...] (rows truth), "total", "accuracy",
+  ///  "per_action": {action: {"correct", "runs", "recall", "precision"}},
+  ///  "pairs": [{"a", "b", "confusions"}]}
+  std::string ToJson() const;
 };
+
+/// The matrix as a PNG heat map (rows truth, columns predicted, counts written in the cells).
+/// @throws romo::Error when the file cannot be written.
+void WriteConfusionPng(const ConfusionMatrix& matrix, const std::string& path, const std::string& title);
 
 }  // namespace romo::sim_manip

@@ -4,8 +4,11 @@
 /// rendered as registered RGB-D with Kinect-like depth noise and holes. Seeded and deterministic.
 ///
 /// URI: sim-manip://ACTION?seed=N[&frames=F][&width=W][&height=H][&fps=R][&noise=0|1]
+///      [&transports=T]
 /// ACTION is one of romo::indoor_manip::ActionNames(). The camera looks at the hand's start
-/// position, so the hand covers the image centre in frame 0 (truth().seed_px).
+/// position, so the hand covers the image centre in frame 0 (truth().seed_px). With T > 0 the
+/// hand does the action at spot A, is carried (lifted, 1 s) to spot B 30 cm away, works there,
+/// and so on, alternating A and B: T transports between two location areas (Fig. 3.11).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -27,6 +30,7 @@ struct SimManipOptions {
   int height_px = 240;
   double fps = 30.0;
   bool noise = true;  ///< depth noise, holes and colour noise
+  int transports = 0;  ///< transports between two work spots (0 = the action in one place)
 
   /// Reads the URI's path (action) and query; @throws romo::Error naming the key and value.
   static SimManipOptions FromUri(const drivers::Uri& uri);
@@ -43,6 +47,11 @@ struct SimManipTruth {
   int seed_v_px = 0;
   /// Three pixels on the free plane (for --plane u1,v1,u2,v2,u3,v3).
   std::vector<std::pair<int, int>> plane_pixels;
+  /// Per work spot (A, then B when transports > 0): the mean of the hand centre's projection onto
+  /// the plane while working there, camera frame. The location areas a perfect tracker finds.
+  std::vector<Eigen::Vector3d> work_area_centres_camera_m;
+  /// Frames [first, last] of each transport (the hand carried between spots).
+  std::vector<std::pair<int, int>> transport_frames;
 };
 
 class SimManipScene {
