@@ -1,7 +1,8 @@
 #pragma once
 /// Connected components over occupied voxels (octree leaves) by depth-first search
 /// (26-neighbourhood), dissertation 3.2 / Fig. 3.8. A dense bit grid over the cloud's bounding box
-/// when it fits dense_grid_max_bytes, else the octree; both give the same blobs. Works on a cloud in any frame (vehicle or indoor camera).
+/// when it fits dense_grid_max_bytes, else the octree; both give the same blobs. Works on a cloud
+/// in any frame (vehicle or indoor camera).
 #include <cstddef>
 #include <limits>
 #include <vector>
