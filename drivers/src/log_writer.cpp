@@ -1,8 +1,11 @@
 // LogWriter: LCM log files through lcm::LogFile, flushed per event, renamed into place on Close.
+// A failed write (disk full) cuts the file back to the last whole frame set and makes later
+// writes throw; Close() still renames it, so the recording keeps every complete frame set.
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <stdio_ext.h>
 #include <unistd.h>
 
 #include <lcm/lcm-cpp.hpp>
@@ -33,6 +36,12 @@ class LogWriter::Impl {
     }
   }
 
+  struct Part {
+    std::string channel;
+    const void* data = nullptr;
+    std::size_t size = 0;
+  };
+
   void Write(const std::string& channel, std::int64_t stamp_ns,
              const std::vector<std::uint8_t>& data) {
     WriteBytes(channel, stamp_ns, data.data(), data.size());
@@ -40,9 +49,38 @@ class LogWriter::Impl {
 
   void WriteBytes(const std::string& channel, std::int64_t stamp_ns, const void* data,
                   std::size_t size) {
-    if (channel.empty()) Fail(path_ + ": event with an empty channel name");
+    WriteAll({Part{channel, data, size}}, stamp_ns);
+  }
+
+  // Writes @p parts as one unit: when one fails (disk full), the file is cut back to where the
+  // unit started, so it holds only whole units (frame sets) and stays a valid log; the writer
+  // then refuses further writes but Close() still renames it into place.
+  void WriteAll(const std::vector<Part>& parts, std::int64_t stamp_ns) {
+    for (const Part& part : parts) {
+      if (part.channel.empty()) Fail(path_ + ": event with an empty channel name");
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     if (!log_) Fail(path_ + ": write after Close()");
+    if (!failure_.empty()) Fail(failure_);
+    const std::uint64_t start_events = events_;
+    const std::uint64_t start_bytes = bytes_;
+    for (const Part& part : parts) {
+      const int error = WriteEvent(part.channel, stamp_ns, part.data, part.size);
+      if (error == 0) continue;
+      const bool cut = CutBack(start_bytes);
+      events_ = start_events;
+      bytes_ = start_bytes;
+      failure_ = partial_path_ + ": write failed after " + std::to_string(events_) + " complete events (" +
+                 std::to_string(bytes_) + " bytes)" + (error == ENOSPC ? " - disk full" : "") + ": " +
+                 std::strerror(error) +
+                 (cut ? "; the recording keeps every complete event before it"
+                      : "; the file could not be cut back, its last event is incomplete");
+      Fail(failure_);
+    }
+  }
+
+  // One event, flushed so a crash loses at most the event being written. Returns 0 or errno.
+  int WriteEvent(const std::string& channel, std::int64_t stamp_ns, const void* data, std::size_t size) {
     lcm::LogEvent event;
     event.eventnum = static_cast<std::int64_t>(events_);
     // LCM logs count time in microseconds.
@@ -50,13 +88,22 @@ class LogWriter::Impl {
     event.channel = channel;
     event.datalen = static_cast<std::int32_t>(size);
     event.data = const_cast<void*>(data);
-    // Flushed per event so a crash loses at most the event being written.
+    errno = 0;
     if (log_->writeEvent(&event) != 0 || std::fflush(log_->getFilePtr()) != 0) {
-      Fail(partial_path_ + ": write failed after " + std::to_string(events_) +
-           " events (disk full?): " + std::strerror(errno));
+      return errno != 0 ? errno : EIO;
     }
     ++events_;
+    // An LCM log event: sync word, event number, timestamp, channel length, data length, channel, data.
     bytes_ += 4 + 8 + 8 + 4 + 4 + channel.size() + size;
+    return 0;
+  }
+
+  // Drops what stdio still buffers and truncates the file to @p bytes (frees the space too).
+  bool CutBack(std::uint64_t bytes) {
+    std::FILE* file = log_->getFilePtr();
+    __fpurge(file);
+    return ::ftruncate(::fileno(file), static_cast<off_t>(bytes)) == 0 &&
+           std::fseek(file, static_cast<long>(bytes), SEEK_SET) == 0;
   }
 
   void Close() {
@@ -78,6 +125,7 @@ class LogWriter::Impl {
   std::unique_ptr<lcm::LogFile> log_;
   std::uint64_t events_ = 0;
   std::uint64_t bytes_ = 0;
+  std::string failure_;  // set by a failed write: later writes fail with it
 };
 
 LogWriter::LogWriter(const std::string& path, ImageEncoding encoding)
@@ -111,7 +159,10 @@ void LogWriter::Write(const FrameSet& frames) {
   if (frames.gnss) {
     parts.emplace_back(kGnssChannel, lcm_codec::EncodeGnss(*frames.gnss, frames.sequence));
   }
-  for (const auto& [channel, data] : parts) impl_->Write(channel, frames.stamp_ns, data);
+  // A frame set goes in whole or not at all (see WriteAll).
+  std::vector<Impl::Part> events;
+  for (const auto& [channel, data] : parts) events.push_back({channel, data.data(), data.size()});
+  impl_->WriteAll(events, frames.stamp_ns);
 }
 
 void LogWriter::WriteRaw(const std::string& channel, std::int64_t stamp_ns, const void* data,
