@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <functional>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -34,7 +36,76 @@ struct Options {
   std::string rig_config_out;
   int max_frames = 300;
   double duration_s = 0.0;
+  // Fault injection.
+  double packet_loss_percent = 0.0;
+  std::vector<std::string> stalls;       // "SERIAL:AT_S:FOR_S"
+  std::vector<std::string> stamp_jumps;  // "AT_S:OFFSET_S"
 };
+
+// A fault scheduled at a time after the cameras start serving.
+struct Fault {
+  double at_s = 0.0;
+  std::string what;
+  std::function<void(drivers::GigeEmulator&)> apply;
+};
+
+std::vector<std::string> SplitColons(const std::string& text) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t colon = text.find(':', start);
+    parts.push_back(text.substr(start, colon - start));
+    if (colon == std::string::npos) return parts;
+    start = colon + 1;
+  }
+}
+
+double ParseSeconds(const std::string& text, const std::string& option, const std::string& value) {
+  try {
+    std::size_t used = 0;
+    const double seconds = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(seconds)) return seconds;
+  } catch (const std::exception&) {
+  }
+  Fail(option + " '" + value + "': '" + text + "' is not a number of seconds");
+}
+
+std::vector<Fault> ScheduleFaults(const Options& options,
+                                  const std::vector<drivers::GigeEmulator::Camera>& cameras) {
+  std::vector<Fault> faults;
+  for (const std::string& stall : options.stalls) {
+    const auto parts = SplitColons(stall);
+    if (parts.size() != 3) Fail("--stall '" + stall + "' must be SERIAL:AT_S:FOR_S, e.g. romo-r0-r:3:2");
+    std::size_t index = cameras.size();
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+      if (cameras[i].serial == parts[0]) index = i;
+    }
+    if (index == cameras.size()) {
+      std::string known;
+      for (const auto& camera : cameras) known += (known.empty() ? "" : ", ") + camera.serial;
+      Fail("--stall '" + stall + "': no served camera has serial '" + parts[0] + "' (served: " + known + ")");
+    }
+    const double at_s = ParseSeconds(parts[1], "--stall", stall);
+    const double for_s = ParseSeconds(parts[2], "--stall", stall);
+    if (at_s < 0.0 || for_s <= 0.0) Fail("--stall '" + stall + "': AT_S must be >= 0 and FOR_S > 0");
+    faults.push_back({at_s, "camera " + parts[0] + " stalled (answers control, sends no frames)",
+                      [index](drivers::GigeEmulator& e) { e.SetStalled(index, true); }});
+    faults.push_back({at_s + for_s, "camera " + parts[0] + " sends frames again",
+                      [index](drivers::GigeEmulator& e) { e.SetStalled(index, false); }});
+  }
+  for (const std::string& jump : options.stamp_jumps) {
+    const auto parts = SplitColons(jump);
+    if (parts.size() != 2) Fail("--stamp-jump '" + jump + "' must be AT_S:OFFSET_S, e.g. 3:-5 (back 5 s)");
+    const double at_s = ParseSeconds(parts[0], "--stamp-jump", jump);
+    const double offset_s = ParseSeconds(parts[1], "--stamp-jump", jump);
+    if (at_s < 0.0 || offset_s == 0.0) Fail("--stamp-jump '" + jump + "': AT_S must be >= 0, OFFSET_S non-zero");
+    const auto offset_ns = static_cast<std::int64_t>(offset_s * 1e9);
+    faults.push_back({at_s, "device timestamps of every camera jump by " + parts[1] + " s",
+                      [offset_ns](drivers::GigeEmulator& e) { e.ShiftStamps(offset_ns); }});
+  }
+  std::sort(faults.begin(), faults.end(), [](const Fault& a, const Fault& b) { return a.at_s < b.at_s; });
+  return faults;
+}
 
 std::string AddressPlus(const std::string& base, std::uint32_t offset) {
   in_addr addr{};
@@ -123,9 +194,14 @@ void Serve(const Options& options) {
   std::printf("rate %.3f Hz%s\n", rate_hz, options.loop ? ", looping" : "");
   std::fflush(stdout);
 
+  std::vector<Fault> faults = ScheduleFaults(options, cameras);
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   drivers::GigeEmulator emulator(std::move(cameras), rate_hz, options.loop);
+  if (options.packet_loss_percent > 0.0) {
+    emulator.SetPacketLoss(options.packet_loss_percent / 100.0);
+    std::printf("fault: every camera drops %.3f %% of its GVSP packets\n", options.packet_loss_percent);
+  }
   // Written only once the cameras answer, so a client waiting for the file can connect at once.
   if (!options.rig_config_out.empty()) config.Save(options.rig_config_out);
 
@@ -133,12 +209,19 @@ void Serve(const Options& options) {
   Progress progress("gige-serve", total);
   const auto start = std::chrono::steady_clock::now();
   while (!g_stop) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     const auto served = emulator.frames_served();
     const std::uint64_t least = *std::min_element(served.begin(), served.end());
     progress.Update(std::min<std::uint64_t>(least, total ? total : least),
                     std::to_string(served.size()) + " cameras");
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    while (!faults.empty() && elapsed >= faults.front().at_s) {
+      faults.front().apply(emulator);
+      // On stdout, flushed: tests and operators line faults up with what the client reports.
+      std::printf("fault at %.2f s: %s\n", elapsed, faults.front().what.c_str());
+      std::fflush(stdout);
+      faults.erase(faults.begin());
+    }
     if (options.duration_s > 0.0 && elapsed >= options.duration_s) break;
     if (emulator.finished()) {
       // Let the last frame leave before the cameras go away.
@@ -147,6 +230,11 @@ void Serve(const Options& options) {
     }
   }
   progress.Finish(g_stop ? "stopped" : "done");
+  const auto stalled = emulator.frames_stalled();
+  for (std::size_t i = 0; i < stalled.size(); ++i) {
+    if (stalled[i] > 0) std::printf("camera %zu: %llu frames not sent while stalled\n", i,
+                                    static_cast<unsigned long long>(stalled[i]));
+  }
 }
 
 void Register(CLI::App& root) {
@@ -169,6 +257,15 @@ void Register(CLI::App& root) {
       ->check(CLI::PositiveNumber);
   command->add_option("--duration", options->duration_s, "Stop after this many seconds (default: never)")
       ->check(CLI::NonNegativeNumber);
+  command->add_option("--packet-loss", options->packet_loss_percent,
+                      "Fault injection: every camera drops this percentage of its GVSP packets")
+      ->check(CLI::Range(0.0, 100.0));
+  command->add_option("--stall", options->stalls,
+                      "Fault injection: SERIAL:AT_S:FOR_S stalls a camera AT_S seconds after start "
+                      "for FOR_S seconds (it stays discoverable but sends no frames); repeatable");
+  command->add_option("--stamp-jump", options->stamp_jumps,
+                      "Fault injection: AT_S:OFFSET_S shifts every camera's device timestamps by "
+                      "OFFSET_S (negative: back in time) from AT_S seconds after start; repeatable");
   command->callback([options] { Serve(*options); });
 }
 

@@ -6,6 +6,9 @@
 #include <atomic>
 #include <climits>
 #include <cstring>
+#include <mutex>
+#include <utility>
+#include <vector>
 
 #include "romo/core/check.hpp"
 #include "romo/drivers/gige.hpp"
@@ -34,6 +37,8 @@ class GigeEmulator::Impl {
     std::atomic<std::uint64_t> served{0};
     std::atomic<std::int64_t> last_index{-1};
     std::atomic<std::uint64_t> mismatched{0};
+    std::atomic<bool> stalled{false};
+    std::atomic<std::uint64_t> stalled_frames{0};
   };
 
   Impl(std::vector<Camera> cameras, double rate_hz, bool loop) : loop_(loop) {
@@ -75,6 +80,41 @@ class GigeEmulator::Impl {
   std::vector<std::uint64_t> FramesServed() const {
     std::vector<std::uint64_t> out;
     for (const auto& served : cameras_) out.push_back(served->served.load());
+    return out;
+  }
+
+  void SetPacketLoss(double ratio) {
+    if (!(ratio >= 0.0 && ratio <= 1.0)) {
+      Fail("gige emulator: packet loss ratio " + std::to_string(ratio) + " must be in [0, 1]");
+    }
+    loss_ratio_ = ratio;
+    for (auto& served : cameras_) {
+      if (!served->stalled) g_object_set(served->gv, "gvsp-lost-ratio", ratio, nullptr);
+    }
+  }
+
+  void SetStalled(std::size_t camera, bool stalled) {
+    if (camera >= cameras_.size()) {
+      Fail("gige emulator: camera index " + std::to_string(camera) + " out of range (" +
+           std::to_string(cameras_.size()) + " cameras)");
+    }
+    Served& served = *cameras_[camera];
+    served.stalled = stalled;
+    // Every GVSP packet dropped: the camera still answers GVCP (discovery, heartbeats, register
+    // access) on its own socket, so to a client it looks alive but silent.
+    g_object_set(served.gv, "gvsp-lost-ratio", stalled ? 1.0 : loss_ratio_.load(), nullptr);
+  }
+
+  void ShiftStamps(std::int64_t offset_ns) {
+    std::lock_guard<std::mutex> lock(shift_mutex_);
+    // Applied from a tick no camera has filled yet, so both cameras of a rig shift together.
+    const std::int64_t from = latest_tick_.load() + 2;
+    shifts_.push_back({from, offset_ns});
+  }
+
+  std::vector<std::uint64_t> FramesStalled() const {
+    std::vector<std::uint64_t> out;
+    for (const auto& served : cameras_) out.push_back(served->stalled_frames.load());
     return out;
   }
 
@@ -133,6 +173,10 @@ class GigeEmulator::Impl {
     std::int64_t index = std::max<std::int64_t>(0, tick - first);
     index = self->loop_ ? index % count : std::min(index, count - 1);
     served->last_index = std::max<std::int64_t>(served->last_index.load(), tick - first);
+    std::int64_t latest = self->latest_tick_.load();
+    while (tick > latest && !self->latest_tick_.compare_exchange_weak(latest, tick)) {
+    }
+    if (served->stalled) ++served->stalled_frames;
 
     const Image& image = served->camera.frames[static_cast<std::size_t>(index)];
     const int width = static_cast<int>(arv_buffer_get_image_width(buffer));
@@ -147,12 +191,26 @@ class GigeEmulator::Impl {
       std::memset(out, 0, row_bytes * height);
       ++served->mismatched;
     }
-    arv_buffer_set_timestamp(buffer, static_cast<guint64>(phase + tick * self->period_ns_));
+    arv_buffer_set_timestamp(buffer, static_cast<guint64>(phase + tick * self->period_ns_ +
+                                                          self->ShiftAt(tick)));
     ++served->served;
+  }
+
+  std::int64_t ShiftAt(std::int64_t tick) {
+    std::lock_guard<std::mutex> lock(shift_mutex_);
+    std::int64_t total = 0;
+    for (const auto& [from, offset] : shifts_) {
+      if (tick >= from) total += offset;
+    }
+    return total;
   }
 
   bool loop_;
   std::int64_t period_ns_ = 0;
+  std::atomic<double> loss_ratio_{0.0};
+  std::atomic<std::int64_t> latest_tick_{LLONG_MIN};
+  std::mutex shift_mutex_;
+  std::vector<std::pair<std::int64_t, std::int64_t>> shifts_;  // (from tick, offset ns)
   std::atomic<std::int64_t> phase_ns_{LLONG_MIN};
   std::atomic<std::int64_t> first_tick_{LLONG_MIN};
   std::vector<std::unique_ptr<Served>> cameras_;
@@ -163,5 +221,9 @@ GigeEmulator::GigeEmulator(std::vector<Camera> cameras, double rate_hz, bool loo
 GigeEmulator::~GigeEmulator() = default;
 std::vector<std::uint64_t> GigeEmulator::frames_served() const { return impl_->FramesServed(); }
 bool GigeEmulator::finished() const { return impl_->Finished(); }
+void GigeEmulator::SetPacketLoss(double ratio) { impl_->SetPacketLoss(ratio); }
+void GigeEmulator::SetStalled(std::size_t camera, bool stalled) { impl_->SetStalled(camera, stalled); }
+void GigeEmulator::ShiftStamps(std::int64_t offset_ns) { impl_->ShiftStamps(offset_ns); }
+std::vector<std::uint64_t> GigeEmulator::frames_stalled() const { return impl_->FramesStalled(); }
 
 }  // namespace romo::drivers

@@ -126,6 +126,9 @@ class GigeSource::Impl {
     GigeCameraDiagnostics diagnostics;
     bool have_frame_id = false;
     std::uint64_t last_frame_id = 0;
+    bool have_stamp = false;
+    std::int64_t last_stamp_ns = 0;
+    std::uint64_t stamp_jumps_back = 0;
     // Aravis statistics of earlier connections, so totals survive reconnects.
     std::uint64_t stats_completed = 0, stats_failures = 0, stats_underruns = 0;
   };
@@ -486,6 +489,18 @@ class GigeSource::Impl {
     }
     camera->have_frame_id = true;
     camera->last_frame_id = frame_id;
+    if (frame) {
+      // Device clocks only grow; one going back was reset (power cycle, PTP step). The frames are
+      // kept (the pairer starts over), the jump is reported.
+      if (camera->have_stamp && frame->stamp_ns < camera->last_stamp_ns) {
+        ++camera->stamp_jumps_back;
+        AddEvent("gige: " + camera->label + ": device timestamp went back by " +
+                 Fixed(1e-9 * static_cast<double>(camera->last_stamp_ns - frame->stamp_ns), 3) +
+                 " s (camera clock reset; jump " + std::to_string(camera->stamp_jumps_back) + ")");
+      }
+      camera->have_stamp = true;
+      camera->last_stamp_ns = frame->stamp_ns;
+    }
     if (!frame) {
       ++counters.incomplete;
       if (!convert_error.empty() && counters.incomplete == 1) {
@@ -524,8 +539,11 @@ class GigeSource::Impl {
         std::chrono::duration<double>(std::max(config_.lost_timeout_s, 3.0 / rig.frame_rate_hz)));
     auto last_frame = Clock::now();
     auto lost_since = last_frame;
-    bool lost = false;
     bool waiting_first_frame = false;
+    // An outage lasts from the first missed frame to the next frame, across reopen attempts; a
+    // camera that reopens but still sends nothing is stalled (alive on GVCP, silent on GVSP).
+    bool in_outage = false;
+    bool stall_reported = false;
     double backoff_s = 0.1;
     auto next_attempt = Clock::now();
     // Software triggers go out on a grid shared by every camera of the process, so both cameras
@@ -554,13 +572,15 @@ class GigeSource::Impl {
         }
         last_failure.clear();
         backoff_s = 0.1;
-        lost = false;
+        const bool first_reopen = !waiting_first_frame;
         waiting_first_frame = true;
         last_frame = Clock::now();
         std::lock_guard<std::mutex> lock(mutex_);
         ++camera->counters.reconnects;
-        AddEvent("gige: " + camera->label + ": reopened (reconnect " +
-                 std::to_string(camera->counters.reconnects) + ")");
+        if (first_reopen) {
+          AddEvent("gige: " + camera->label + ": reopened (reconnect " +
+                   std::to_string(camera->counters.reconnects) + ")");
+        }
       }
       if (rig.trigger == TriggerMode::kSoftware && Clock::now() >= next_trigger) {
         GError* error = nullptr;
@@ -578,19 +598,27 @@ class GigeSource::Impl {
           std::lock_guard<std::mutex> lock(mutex_);
           camera->counters.gap_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(gap).count();
           AddEvent("gige: " + camera->label + ": frames again after reconnect " +
-                   std::to_string(camera->counters.reconnects) + ", gap " + Fixed(Seconds(gap), 3) + " s");
+                   std::to_string(camera->counters.reconnects) + ", gap " + Fixed(Seconds(gap), 3) + " s" +
+                   (stall_reported ? " (was stalled)" : ""));
         }
         waiting_first_frame = false;
+        in_outage = false;
+        stall_reported = false;
         last_frame = now;
       } else if (camera->control_lost || now - last_frame > lost_after) {
-        if (!lost) {
-          lost = true;
+        if (!in_outage) {
+          in_outage = true;
           lost_since = last_frame;
           std::lock_guard<std::mutex> lock(mutex_);
           AddEvent("gige: " + camera->label + ": camera lost (" +
                    (camera->control_lost ? std::string("control channel lost")
                                          : "no frame for " + Fixed(Seconds(now - last_frame), 2) + " s") +
                    "); reopening with back-off");
+        } else if (waiting_first_frame && !camera->control_lost && !stall_reported) {
+          stall_reported = true;
+          std::lock_guard<std::mutex> lock(mutex_);
+          AddEvent("gige: " + camera->label + ": camera stalled (reopened, answers control, but no "
+                   "frame for " + Fixed(Seconds(now - last_frame), 2) + " s); retrying");
         }
         CloseCamera(camera, /*stop=*/false);
         next_attempt = now;

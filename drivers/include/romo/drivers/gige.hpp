@@ -195,6 +195,19 @@ class GigeEmulator {
   /// True once every camera has served its whole sequence (never with loop).
   bool finished() const;
 
+  // Fault injection (hardware-in-loop tests, `romo gige-serve --packet-loss/--stall/...`).
+  /// Every camera drops this fraction of its GVSP packets (0 to 1), as a lossy link would.
+  /// @throws romo::Error for a ratio outside [0, 1].
+  void SetPacketLoss(double ratio);
+  /// A stalled camera keeps answering discovery and control (GVCP) but sends no frame (every
+  /// GVSP packet dropped) until un-stalled. @throws romo::Error for an index out of range.
+  void SetStalled(std::size_t camera, bool stalled);
+  /// From the next tick on, every camera's device timestamps are shifted by @p offset_ns
+  /// (negative: the camera clocks jump back, as after a clock reset). Cumulative.
+  void ShiftStamps(std::int64_t offset_ns);
+  /// Frames each camera sent while stalled (filled but never delivered).
+  std::vector<std::uint64_t> frames_stalled() const;
+
  private:
   class Impl;
   std::unique_ptr<Impl> impl_;
