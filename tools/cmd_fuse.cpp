@@ -27,6 +27,9 @@ struct FuseOptions {
   int timeout_ms = 500;
   double idle_exit_s = 10.0;
   long long frames = 0;
+  // A full-resolution rig cloud (782 x 582 points at 8 bytes) is 3.6 MB; anything far larger is
+  // refused before decoding so a bad or hostile sender cannot make fuse allocate without bound.
+  std::size_t max_message_bytes = 8u << 20;
 };
 
 void Fuse(const FuseOptions& o) {
@@ -56,6 +59,13 @@ void Fuse(const FuseOptions& o) {
   bus.Subscribe(std::string(planning_iface::kRigCloudChannelPrefix) + "[0-9]+",
                 [&](const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
                   last_message = Clock::now();
+                  if (size > o.max_message_bytes) {
+                    pipe.CountMalformed();
+                    pipe.ReportEvent("oversized message on " + channel + ": " + std::to_string(size) +
+                                     " bytes > --max-message-bytes " + std::to_string(o.max_message_bytes) +
+                                     "; dropped undecoded");
+                    return;
+                  }
                   std::string why;
                   auto rc = planning_iface::DecodeRigCloud(data, size, &why);
                   if (!rc || channel != planning_iface::RigCloudChannel(rc->rig_id)) {
@@ -99,6 +109,9 @@ void Fuse(const FuseOptions& o) {
   };
 
   const std::size_t all = calibration.rigs.size();
+  // Subscribed from here on: a sender (or test) may start once this line is out.
+  std::fprintf(stderr, "romo fuse: listening on %s for %zu rigs\n", o.lcm_url.c_str(), all);
+  std::fflush(stderr);
   while (o.frames <= 0 || processed < o.frames) {
     bus.Handle(20);
     // Oldest first: complete frames at once, incomplete ones after the timeout or when a newer
@@ -130,6 +143,10 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--timeout-ms", opts->timeout_ms, "wait this long for a frame's missing rigs")->capture_default_str();
   cmd->add_option("--idle-exit", opts->idle_exit_s, "exit after this many seconds without messages")->capture_default_str();
   cmd->add_option("--frames", opts->frames, "exit after this many frames (0 = until idle)");
+  cmd->add_option("--max-message-bytes", opts->max_message_bytes,
+                  "refuse (count as malformed) rig clouds larger than this")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->callback([opts] { Fuse(*opts); });
 });
 

@@ -1,10 +1,15 @@
-// `romo record --source URI --out FILE.lcmlog [--frames N] [--png]`: any frame source to an LCM log.
+// `romo record --source URI --out FILE.lcmlog [--frames N] [--png] [--status-lcm-url URL]`: any
+// frame source to an LCM log, optionally publishing a perception status (camera losses, events,
+// write failures) after every frame set so faults show on the bus while recording.
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -13,6 +18,8 @@
 #include "romo/core/check.hpp"
 #include "romo/drivers/frame_source.hpp"
 #include "romo/drivers/recording.hpp"
+#include "romo/planning_iface/lcm_bus.hpp"
+#include "romo/planning_iface/messages.hpp"
 
 namespace romo::tools {
 namespace {
@@ -26,6 +33,7 @@ struct RecordOptions {
   std::string out;
   std::uint64_t frames = 0;
   bool png = false;
+  std::string status_lcm_url;
 };
 
 void PrintSourceEvents(const drivers::FrameSource& source) {
@@ -44,12 +52,88 @@ void PrintSourceEvents(const drivers::FrameSource& source) {
   }
 }
 
+// The recorder's perception status: per rig the frame sets it was in, frames_processed = sets
+// written, frames_dropped = camera frames that never reached the file (incomplete, unpaired,
+// dropped), events = source events and the recorder's own (stamps going back, write failures),
+// each published once.
+class StatusPublisher {
+ public:
+  explicit StatusPublisher(const std::string& url) {
+    if (!url.empty()) bus_ = std::make_unique<planning_iface::LcmBus>(url);
+  }
+
+  void AddEvent(const std::string& event) { own_events_.push_back(event); }
+
+  void CountSet(const drivers::FrameSet& frames) {
+    last_stamp_ns_ = frames.stamp_ns;
+    last_sequence_ = static_cast<std::int64_t>(frames.sequence);
+    present_.clear();
+    for (const auto& stereo : frames.stereo) {
+      ++rig_frames_[stereo.rig_id];
+      present_[stereo.rig_id] = true;
+    }
+    ++sets_;
+  }
+
+  planning_iface::PerceptionStatus Build(const drivers::SourceStatus& source, double write_ms) {
+    planning_iface::PerceptionStatus status;
+    status.stamp_ns = last_stamp_ns_;
+    status.frame_sequence = last_sequence_;
+    for (const auto& [rig_id, frames] : rig_frames_) {
+      planning_iface::RigStatus rig;
+      rig.rig_id = rig_id;
+      rig.present = present_.count(rig_id) > 0;
+      rig.frames = frames;
+      rig.dropped = sets_ - frames;  // sets recorded without this rig
+      status.rigs.push_back(rig);
+    }
+    status.stages.push_back({"write", write_ms});
+    status.total_latency_ms = write_ms;
+    status.frames_processed = sets_;
+    for (const auto& camera : source.cameras) {
+      status.frames_dropped += static_cast<std::int64_t>(camera.incomplete + camera.unpaired + camera.dropped);
+    }
+    for (std::size_t i = source_events_published_; i < source.events.size(); ++i) {
+      status.events.push_back(source.events[i]);
+    }
+    source_events_published_ = source.events.size();
+    for (auto& event : own_events_) status.events.push_back(std::move(event));
+    own_events_.clear();
+    return status;
+  }
+
+  void Publish(const drivers::FrameSource& source, double write_ms) {
+    if (!bus_) return;
+    const auto status = Build(source.status(), write_ms);
+    try {
+      bus_->Publish(planning_iface::kPerceptionStatusChannel, planning_iface::Encode(status));
+    } catch (const Error& e) {
+      // Status is best effort: a bus problem must not stop the recording.
+      if (!publish_failed_) std::fprintf(stderr, "romo record: publishing the status failed: %s\n", e.what());
+      publish_failed_ = true;
+    }
+  }
+
+ private:
+  std::unique_ptr<planning_iface::LcmBus> bus_;
+  std::map<int, std::int64_t> rig_frames_;
+  std::map<int, bool> present_;
+  std::int64_t sets_ = 0;
+  std::int64_t last_stamp_ns_ = 0;
+  std::int64_t last_sequence_ = 0;
+  std::size_t source_events_published_ = 0;
+  std::vector<std::string> own_events_;
+  bool publish_failed_ = false;
+};
+
 void Record(const RecordOptions& options) {
+  using Clock = std::chrono::steady_clock;
   // SIGINT/SIGTERM stop the loop; the writer then closes and renames the file as usual.
   // Installed first: a signal while the source opens must not kill the process either.
   g_stop = false;
   auto* old_int = std::signal(SIGINT, OnStopSignal);
   auto* old_term = std::signal(SIGTERM, OnStopSignal);
+  StatusPublisher status(options.status_lcm_url);
   // Opening errors (bad URI, missing file, no camera) are bad input: romo::Error -> exit 2.
   std::unique_ptr<drivers::FrameSource> source = drivers::OpenSource(options.source);
   drivers::LogWriter writer(options.out,
@@ -59,11 +143,28 @@ void Record(const RecordOptions& options) {
   std::uint64_t count = 0;
   bool calibration_written = false;
   std::optional<std::string> failure;
+  bool write_failed = false;
+  std::optional<std::int64_t> last_stamp;
+  std::uint64_t stamps_back = 0;
   while (!g_stop && (options.frames == 0 || count < options.frames)) {
     std::optional<drivers::FrameSet> frames;
     try {
       frames = source->Next();
       if (!frames) break;
+    } catch (const std::exception& e) {
+      failure = std::string("source failed: ") + e.what();
+      break;
+    }
+    if (last_stamp && frames->stamp_ns < *last_stamp) {
+      // Kept as recorded (nothing is lost); consumers that need order (replay) skip and count.
+      ++stamps_back;
+      status.AddEvent("record: frame set " + std::to_string(count) + " stamp went back by " +
+                      std::to_string(static_cast<double>(*last_stamp - frames->stamp_ns) * 1e-9) +
+                      " s (kept; jump " + std::to_string(stamps_back) + ")");
+    }
+    last_stamp = frames->stamp_ns;
+    const auto write_start = Clock::now();
+    try {
       if (!calibration_written) {
         // Written first, stamped like the first frame set so seek offsets start there.
         if (const auto* calibration = source->calibration()) {
@@ -73,14 +174,23 @@ void Record(const RecordOptions& options) {
       }
       writer.Write(*frames);
     } catch (const std::exception& e) {
-      failure = e.what();
+      failure = std::string("writing the recording failed: ") + e.what();
+      write_failed = true;
       break;
     }
     ++count;
+    status.CountSet(*frames);
+    // Published after the set is on disk: a status saying N sets means N sets are in the file.
+    status.Publish(*source, std::chrono::duration<double, std::milli>(Clock::now() - write_start).count());
     progress.Update(count, std::to_string(writer.bytes_written() / (1024 * 1024)) + " MB");
   }
-  if (!calibration_written && source->calibration() != nullptr) {
-    writer.WriteCalibration(*source->calibration(), 0);
+  if (!calibration_written && !write_failed && source->calibration() != nullptr) {
+    try {
+      writer.WriteCalibration(*source->calibration(), 0);
+    } catch (const std::exception& e) {
+      failure = std::string("writing the recording failed: ") + e.what();
+      write_failed = true;
+    }
   }
   progress.Finish(std::to_string(writer.bytes_written() / (1024 * 1024)) + " MB");
   writer.Close();
@@ -92,12 +202,19 @@ void Record(const RecordOptions& options) {
               static_cast<unsigned long long>(writer.events_written()),
               static_cast<double>(writer.bytes_written()) / 1e6, options.out.c_str(),
               g_stop ? " (interrupted)" : "");
+  if (stamps_back > 0) {
+    std::fprintf(stderr, "romo record: frame set stamps went back %llu times (all sets kept)\n",
+                 static_cast<unsigned long long>(stamps_back));
+  }
   if (failure) {
-    std::fprintf(stderr, "romo record: source failed after %llu frame sets: %s (all %llu kept in %s)\n",
-                 static_cast<unsigned long long>(count), failure->c_str(),
-                 static_cast<unsigned long long>(count), options.out.c_str());
+    const std::string message = "romo record: " + *failure + " (stopped after " + std::to_string(count) +
+                                " frame sets; all " + std::to_string(count) + " kept in " + options.out + ")";
+    status.AddEvent(message);
+    status.Publish(*source, 0.0);
+    std::fprintf(stderr, "%s\n", message.c_str());
     throw CLI::RuntimeError(kExitRuntimeFailure);
   }
+  status.Publish(*source, 0.0);
 }
 
 void Register(CLI::App& root) {
@@ -108,6 +225,9 @@ void Register(CLI::App& root) {
   command->add_option("--out", options->out, "Output LCM log file (.lcmlog)")->required();
   command->add_option("--frames", options->frames, "Stop after N frame sets (0 = until the end)");
   command->add_flag("--png", options->png, "Store images as lossless PNG instead of raw");
+  command->add_option("--status-lcm-url", options->status_lcm_url,
+                      "Publish a perception status (ROMO_PERCEPTION_STATUS: sets written, camera "
+                      "frames lost, events) on this LCM URL after every frame set");
   command->callback([options] { Record(*options); });
 }
 
