@@ -25,6 +25,8 @@ struct ReplayOptions {
   long long frames = 0;
   int threads = 2;
   bool no_pictures = false;
+  bool loop = false;
+  double duration_s = 0.0;
 };
 
 void Replay(const ReplayOptions& o) {
@@ -48,8 +50,14 @@ void Replay(const ReplayOptions& o) {
   pipeline::RunOptions run;
   run.realtime = o.realtime;
   run.max_frames = o.frames;
+  run.duration_s = o.duration_s;
+  if (o.loop && o.frames <= 0 && o.duration_s <= 0.0) {
+    Fail("replay: --loop needs --duration SECONDS or --frames N to end");
+  }
+  pipeline::LoopedLog looped(reader);
+  drivers::FrameSource& source = o.loop ? static_cast<drivers::FrameSource&>(looped) : reader;
   const auto stats = pipeline::RunFrames(
-      reader, pipe, sink, run, [&reader] { return reader.other_events(); },
+      source, pipe, sink, run, [&reader] { return reader.other_events(); },
       [&](std::int64_t done, const pipeline::FrameResult& r) {
         progress.Update(static_cast<std::uint64_t>(done),
                         std::to_string(r.obstacles.obstacles.size()) + " obstacles, " +
@@ -59,6 +67,7 @@ void Replay(const ReplayOptions& o) {
   std::string extra = "\"source\": \"" + pipeline::JsonEscape(o.log) +
                       "\", \"skipped_out_of_order\": " + std::to_string(stats.skipped_out_of_order) +
                       ", \"wall_s\": " + std::to_string(stats.wall_s);
+  if (o.loop) extra += ", \"loops\": " + std::to_string(looped.loops());
   if (reader.truncated()) {
     extra += ", \"log_truncated_at\": " + std::to_string(reader.truncation_offset());
     std::fprintf(stderr, "romo: replay: %s is truncated at byte %lld; replayed every complete frame\n",
@@ -86,6 +95,9 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--frames", opts->frames, "stop after this many frames (0 = all)")->capture_default_str();
   cmd->add_option("--threads", opts->threads, "stereo threads (rigs in parallel)")->capture_default_str();
   cmd->add_flag("--no-pictures", opts->no_pictures, "skip the per-frame top-view PNGs");
+  cmd->add_flag("--loop", opts->loop, "start over at the end (stamps keep increasing); needs --duration or --frames");
+  cmd->add_option("--duration", opts->duration_s, "stop after this many seconds of wall time (0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([opts] { Replay(*opts); });
 });
 

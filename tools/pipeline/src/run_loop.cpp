@@ -5,6 +5,48 @@
 
 namespace romo::pipeline {
 
+LoopedLog::LoopedLog(drivers::LogReader& reader) : reader_(reader) {}
+
+std::optional<drivers::FrameSet> LoopedLog::Next() {
+  std::optional<drivers::FrameSet> frames = reader_.Next();
+  if (!frames) {
+    if (!first_stamp_ns_) return std::nullopt;  // an empty recording stays empty
+    reader_.Seek(0.0);
+    frames = reader_.Next();
+    if (!frames) return std::nullopt;
+    ++loops_;
+    // The next pass starts one period after the last frame of this one.
+    stamp_offset_ns_ += *last_stamp_ns_ - *first_stamp_ns_ + period_ns_.value_or(100000000);
+    sequence_offset_ += last_sequence_ - first_sequence_ + 1;
+  }
+  if (!first_stamp_ns_) {
+    first_stamp_ns_ = frames->stamp_ns;
+    first_sequence_ = frames->sequence;
+  } else if (loops_ == 0 && frames->stamp_ns > *last_stamp_ns_) {
+    period_ns_ = frames->stamp_ns - *last_stamp_ns_;
+  }
+  if (loops_ == 0) {
+    last_stamp_ns_ = frames->stamp_ns;
+    last_sequence_ = frames->sequence;
+  }
+  if (loops_ > 0) {
+    const std::int64_t dt = stamp_offset_ns_;
+    frames->stamp_ns += dt;
+    frames->sequence += sequence_offset_;
+    for (auto& stereo : frames->stereo) {
+      stereo.left.stamp_ns += dt;
+      stereo.right.stamp_ns += dt;
+    }
+    if (frames->rgbd) frames->rgbd->stamp_ns += dt;
+    if (frames->vehicle) frames->vehicle->stamp_ns += dt;
+    if (frames->gnss) frames->gnss->stamp_ns += dt;
+  }
+  return frames;
+}
+
+const drivers::Calibration* LoopedLog::calibration() const { return reader_.calibration(); }
+drivers::SourceStatus LoopedLog::status() const { return reader_.status(); }
+
 RunStats RunFrames(drivers::FrameSource& source, Pipeline& pipeline, OutputSink& outputs,
                    const RunOptions& options, const PassthroughFn& passthrough,
                    const ProgressFn& progress) {
@@ -13,6 +55,10 @@ RunStats RunFrames(drivers::FrameSource& source, Pipeline& pipeline, OutputSink&
   const auto start = Clock::now();
   std::optional<std::int64_t> first_stamp, last_stamp;
   while (options.max_frames <= 0 || stats.frames < options.max_frames) {
+    if (options.duration_s > 0.0 &&
+        std::chrono::duration<double>(Clock::now() - start).count() >= options.duration_s) {
+      break;
+    }
     std::optional<drivers::FrameSet> frames = source.Next();
     if (!frames) break;
     std::vector<drivers::LogEvent> extra = passthrough ? passthrough() : std::vector<drivers::LogEvent>{};
