@@ -1,12 +1,15 @@
 // Hardware-in-loop: recordings served by `romo gige-serve` as emulated GigE Vision cameras, grabbed
 // through gige:// (the real Aravis path), recorded and read back pixel for pixel. Inside netns-run.
+#include <chrono>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "hil_support.hpp"
+#include "served_recording.hpp"
 #include "romo/drivers/gige.hpp"
 #include "romo/drivers/recording.hpp"
 #include "test_support.hpp"
@@ -14,119 +17,12 @@
 namespace romo::drivers {
 namespace {
 
+using hil::Check;
+using hil::CheckRecorded;
+using hil::Served;
+using hil::WriteRecording;
+
 constexpr std::int64_t kPeriodNs = 100000000;  // recordings at 10 Hz
-
-// Textured content that differs per frame, rig and side, so every image is identifiable.
-Image Textured(PixelFormat format, int width, int height, int frame, int rig, int side) {
-  Image image = Image::Allocate(format, width, height);
-  const int channels = BytesPerPixel(format) == 3 ? 3 : 1;
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      for (int c = 0; c < channels; ++c) {
-        const unsigned value = (x * 7u + y * 13u + ((x / 8 + y / 8) % 2) * 300u + frame * 101u +
-                                rig * 37u + side * 57u + c * 71u) * 2654435761u >> 7;
-        if (format == PixelFormat::kMono16) {
-          const std::uint16_t sample = value % 4096;  // 12-bit camera values
-          std::memcpy(image.row(y) + 2 * x, &sample, 2);
-        } else {
-          image.row(y)[x * channels + c] = static_cast<std::uint8_t>(value);
-        }
-      }
-    }
-  }
-  return image;
-}
-
-bool Same(const Image& a, const Image& b) {
-  if (a.width != b.width || a.height != b.height || a.format != b.format) return false;
-  const std::size_t row = static_cast<std::size_t>(a.width) * BytesPerPixel(a.format);
-  for (int y = 0; y < a.height; ++y) {
-    if (std::memcmp(a.row(y), b.row(y), row) != 0) return false;
-  }
-  return true;
-}
-
-struct Served {
-  // frames[rig][k] = {left, right}
-  std::vector<std::vector<std::pair<Image, Image>>> frames;
-};
-
-Served WriteRecording(const std::string& path, int rigs, int count, int width, int height,
-                      const Calibration* calibration) {
-  Served served;
-  served.frames.resize(rigs);
-  LogWriter writer(path);
-  if (calibration) writer.WriteCalibration(*calibration, 0);
-  for (int k = 0; k < count; ++k) {
-    FrameSet set;
-    set.stamp_ns = (k + 1) * kPeriodNs;
-    set.sequence = k;
-    for (int rig = 0; rig < rigs; ++rig) {
-      // The RoMo front rig is colour, the others 12-bit mono.
-      const PixelFormat format = (rig == 0 && rigs > 1) ? PixelFormat::kRgb8 : PixelFormat::kMono16;
-      StereoFrame stereo;
-      stereo.rig_id = rig;
-      stereo.left.image = Textured(format, width, height, k, rig, 0);
-      stereo.right.image = Textured(format, width, height, k, rig, 1);
-      stereo.left.stamp_ns = stereo.right.stamp_ns = set.stamp_ns;
-      stereo.left.sequence = stereo.right.sequence = k;
-      stereo.left.camera_id = "rig" + std::to_string(rig) + "L";
-      stereo.right.camera_id = "rig" + std::to_string(rig) + "R";
-      served.frames[rig].push_back({stereo.left.image, stereo.right.image});
-      set.stereo.push_back(std::move(stereo));
-    }
-    writer.Write(set);
-  }
-  writer.Close();
-  return served;
-}
-
-// Index of the served frame @p image equals, or -1.
-int IndexOf(const std::vector<std::pair<Image, Image>>& frames, const Image& image, bool left) {
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    if (Same(left ? frames[k].first : frames[k].second, image)) return static_cast<int>(k);
-  }
-  return -1;
-}
-
-struct Check {
-  int sets = 0;
-  int complete_sets = 0;     // every rig present
-  int consecutive_steps = 0;  // served index advanced by exactly one between sets
-  int steps = 0;
-};
-
-// Every recorded image must equal a served one, left and right (and all rigs) the same instant.
-Check CheckRecorded(const std::string& path, const Served& served) {
-  Check check;
-  LogReader reader(path);
-  int previous = -1;
-  const int count = static_cast<int>(served.frames[0].size());
-  while (auto set = reader.Next()) {
-    if (set->stereo.empty()) continue;
-    ++check.sets;
-    int index = -1;
-    for (const StereoFrame& stereo : set->stereo) {
-      EXPECT_GE(stereo.rig_id, 0);
-      EXPECT_LT(stereo.rig_id, static_cast<int>(served.frames.size()));
-      const auto& frames = served.frames[stereo.rig_id];
-      const int left = IndexOf(frames, stereo.left.image, true);
-      const int right = IndexOf(frames, stereo.right.image, false);
-      EXPECT_GE(left, 0) << "rig " << stereo.rig_id << " left image of set " << check.sets << " was never served";
-      EXPECT_EQ(left, right) << "rig " << stereo.rig_id << " paired images of different instants";
-      if (index < 0) index = left;
-      EXPECT_EQ(left, index) << "rigs of one frame set show different instants";
-      EXPECT_EQ(stereo.left.stamp_ns, stereo.right.stamp_ns);
-    }
-    if (set->stereo.size() == served.frames.size()) ++check.complete_sets;
-    if (previous >= 0) {
-      ++check.steps;
-      if (index == (previous + 1) % count) ++check.consecutive_steps;
-    }
-    previous = index;
-  }
-  return check;
-}
 
 // Grabs @p frames sets from gige://@p rig_config into @p out: with `romo record` when the tree has
 // it, else through LogWriter in process (same source, same writer).
@@ -188,8 +84,15 @@ TEST(GigeServeHilTest, TwelveCamerasOfSixRigsDeliverSynchronisedSets) {
   ASSERT_EQ(config.rigs.size(), 6u);
   EXPECT_EQ(config.rigs[0].pixel_format, GigePixelFormat::kRgb8);
 
-  constexpr int kFrames = 20;
-  GigeCameraDiagnostics worst;
+  // Judged by counting frames, not by rates: grab threads starved of CPU (12 cameras on 2 shared
+  // cores, load ~15 while other modules build) deliver sets late or lose frames, which changes
+  // how many sets it takes to see kCompleteSets complete ones, but every frame lost must be
+  // counted and every set delivered must be synchronised.
+  constexpr int kCompleteSets = 20;
+  constexpr int kMaxSets = 10 * kCompleteSets;
+  constexpr double kMaxSeconds = 90.0;
+  SourceStatus status;
+  int sets = 0, complete = 0;
   {
     auto source = OpenSource("gige://" + dir / "rigs.yaml");
     // The first sets may miss rigs whose cameras were still being configured when the first
@@ -197,30 +100,53 @@ TEST(GigeServeHilTest, TwelveCamerasOfSixRigsDeliverSynchronisedSets) {
     constexpr int kWarmupSets = 5;
     for (int i = 0; i < kWarmupSets; ++i) ASSERT_TRUE(source->Next());
     LogWriter writer(dir / "grabbed.lcmlog");
-    for (int i = 0; i < kFrames; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    while (complete < kCompleteSets && sets < kMaxSets &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < kMaxSeconds) {
       auto set = source->Next();
       ASSERT_TRUE(set);
-      std::printf("set %d stamp %lld rigs:", i, static_cast<long long>(set->stamp_ns));
-      for (const auto& stereo : set->stereo) {
-        std::printf(" %d@%+lldms", stereo.rig_id, static_cast<long long>((stereo.stamp_ns() - set->stamp_ns) / 1000000));
-      }
-      std::printf("\n");
+      ++sets;
+      if (set->stereo.size() == 6u) ++complete;
       writer.Write(*set);
     }
     writer.Close();
-    const SourceStatus status = source->status();
-    ASSERT_EQ(status.cameras.size(), 12u);
-    for (const auto& camera : status.cameras) {
-      EXPECT_GT(camera.completed, 0u) << camera.camera_id;
-      EXPECT_EQ(camera.incomplete, 0u) << camera.camera_id;  // loopback loses nothing
+    status = source->status();
+  }
+  ASSERT_EQ(status.cameras.size(), 12u);
+  std::map<std::string, std::uint64_t> lost;  // per camera id: counted losses
+  for (const auto& camera : status.cameras) {
+    EXPECT_GT(camera.completed, 0u) << camera.camera_id;
+    EXPECT_EQ(camera.incomplete, 0u) << camera.camera_id;  // loopback loses no packet
+    lost[camera.camera_id] = camera.incomplete + camera.unpaired + camera.dropped;
+  }
+  EXPECT_EQ(complete, kCompleteSets) << "only " << complete << " complete sets in " << sets;
+
+  const Check check = CheckRecorded(dir / "grabbed.lcmlog", served);  // every image synchronised
+  EXPECT_EQ(check.sets, sets);
+  // Every frame a rig skipped between two of its sets is one its cameras counted as lost (a rig
+  // left out of a set comes in a later one, so its own stamps advance one period at a time).
+  std::map<int, std::vector<std::int64_t>> rig_stamps;
+  {
+    LogReader reader(dir / "grabbed.lcmlog");
+    while (auto set = reader.Next()) {
+      for (const auto& stereo : set->stereo) rig_stamps[stereo.rig_id].push_back(stereo.stamp_ns());
     }
   }
-  const Check check = CheckRecorded(dir / "grabbed.lcmlog", served);
-  EXPECT_EQ(check.sets, kFrames);
-  // Sets missing a rig happen when a grab thread is starved of CPU (12 cameras on 2 shared cores,
-  // load ~15 while other modules build: 6 to 18 of 20 complete seen); half must be complete.
-  EXPECT_GE(check.complete_sets, kFrames / 2);
-  EXPECT_GE(check.consecutive_steps, check.steps / 2) << check.consecutive_steps << "/" << check.steps;
+  for (const auto& rig : config.rigs) {
+    const auto& stamps = rig_stamps[rig.rig_id];
+    ASSERT_FALSE(stamps.empty()) << "rig " << rig.rig_id;
+    std::int64_t skipped = 0;
+    for (std::size_t i = 1; i < stamps.size(); ++i) {
+      const std::int64_t steps = (stamps[i] - stamps[i - 1] + kPeriodNs / 2) / kPeriodNs;
+      EXPECT_GE(steps, 1) << "rig " << rig.rig_id << " stamps must only advance";
+      skipped += std::max<std::int64_t>(0, steps - 1);
+    }
+    const std::uint64_t counted = lost[rig.left.Describe()] + lost[rig.right.Describe()];
+    EXPECT_LE(static_cast<std::uint64_t>(skipped), counted) << "rig " << rig.rig_id << ": frames lost uncounted";
+    std::printf("rig %d: %zu sets, %lld frames skipped, %llu counted lost\n", rig.rig_id, stamps.size(),
+                static_cast<long long>(skipped), static_cast<unsigned long long>(counted));
+  }
+  std::printf("%d complete of %d sets (%.0f %%)\n", complete, sets, 100.0 * complete / std::max(sets, 1));
 }
 
 }  // namespace

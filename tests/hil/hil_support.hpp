@@ -37,6 +37,20 @@ class Background {
     pid_ = -1;
     return status;
   }
+  /// Waits up to @p timeout_s for the process to end by itself; its wait status, or -1 on
+  /// timeout (then it is left running).
+  int Wait(double timeout_s) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (pid_ > 0 && std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return status;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -1;
+  }
   bool running() const { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
   pid_t pid() const { return pid_; }
 
