@@ -1,6 +1,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -63,6 +66,21 @@ std::vector<Point2> ConvexHull(std::vector<Point2> pts) {
   }
   hull.resize(k - 1);
   return hull;
+}
+
+/// [lo, hi] of @p values without the @p trim fraction at each end (min and max for 0).
+/// Reorders @p values.
+std::pair<float, float> TrimmedRange(std::vector<float>& values, float trim) {
+  if (trim <= 0.f) {
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    return {*lo, *hi};
+  }
+  const std::size_t n = values.size();
+  const auto k = static_cast<std::size_t>(trim * static_cast<float>(n - 1));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  const float lo = values[k];
+  std::nth_element(values.begin(), values.begin() + (n - 1 - k), values.end());
+  return {lo, values[n - 1 - k]};
 }
 
 }  // namespace
@@ -157,12 +175,15 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
 }
 
 Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
-                    std::optional<float> hint_yaw_rad) {
+                    std::optional<float> hint_yaw_rad, float trim_fraction) {
   CheckIndices(xyz, indices, "FitVerticalBox");
   if (!(up.allFinite() && std::abs(up.norm() - 1.f) < 1e-3f)) {
     std::ostringstream msg;
     msg << "FitVerticalBox: up must be a unit vector, got (" << up.transpose() << ")";
     Fail(msg.str());
+  }
+  if (!(trim_fraction >= 0.f && trim_fraction <= 0.25f)) {
+    Fail("FitVerticalBox: trim_fraction must be in [0, 0.25], got " + std::to_string(trim_fraction));
   }
   // Ground-plane basis: the frame's x (or y when x is nearly vertical) projected onto the plane.
   Eigen::Vector3f e1 = Eigen::Vector3f::UnitX() - up.x() * up;
@@ -179,29 +200,29 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
     h_lo = std::min(h_lo, p.dot(up));
     h_hi = std::max(h_hi, p.dot(up));
   }
-  const std::vector<Point2> hull = ConvexHull(std::move(footprint));
-
-  // Minimum-area rectangle: one side lies on a hull edge (rotating calipers, O(h^2) is plenty
-  // for the hull sizes of single objects).
+  if (trim_fraction > 0.f) {
+    std::vector<float> heights;
+    heights.reserve(indices.size());
+    for (int i : indices) heights.push_back(xyz.col(i).dot(up));
+    const auto [lo, hi] = TrimmedRange(heights, trim_fraction);
+    h_lo = lo;
+    h_hi = hi;
+  }
   float best_area = 1e30f, best_yaw = 0.f;
-  Point2 best_center = hull.front();
+  Point2 best_center = footprint.front();
   float best_l = 0.f, best_w = 0.f;
-  const std::size_t edges = hull.size() < 2 ? 1 : hull.size();
-  for (std::size_t e = 0; e < edges; ++e) {
-    float angle = 0.f;
-    if (hull.size() >= 2) {
-      const Point2 d = hull[(e + 1) % hull.size()] - hull[e];
-      angle = std::atan2(d.y(), d.x());
-    }
+  // One heading candidate: the rectangle of the footprint's extents along it (trimmed or exact).
+  std::vector<float> along, across;
+  auto try_heading = [&](float angle, const std::vector<Point2>& pts, float trim) {
     const float c = std::cos(angle), s = std::sin(angle);
-    float a_lo = 1e30f, a_hi = -1e30f, b_lo = 1e30f, b_hi = -1e30f;
-    for (const auto& p : hull) {
-      const float a = c * p.x() + s * p.y(), b = -s * p.x() + c * p.y();
-      a_lo = std::min(a_lo, a);
-      a_hi = std::max(a_hi, a);
-      b_lo = std::min(b_lo, b);
-      b_hi = std::max(b_hi, b);
+    along.clear();
+    across.clear();
+    for (const auto& p : pts) {
+      along.push_back(c * p.x() + s * p.y());
+      across.push_back(-s * p.x() + c * p.y());
     }
+    const auto [a_lo, a_hi] = TrimmedRange(along, trim);
+    const auto [b_lo, b_hi] = TrimmedRange(across, trim);
     const float area = (a_hi - a_lo) * (b_hi - b_lo);
     // Ties (and degenerate, zero-area footprints) keep the longest side as the heading.
     if (area < best_area - 1e-9f || (std::abs(area - best_area) <= 1e-9f && a_hi - a_lo > best_l)) {
@@ -212,7 +233,33 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
       const float am = 0.5f * (a_lo + a_hi), bm = 0.5f * (b_lo + b_hi);
       best_center = Point2(c * am - s * bm, s * am + c * bm);
     }
+  };
+  if (trim_fraction > 0.f) {
+    // Outliers make the exact hull's rectangle follow them; the trimmed rectangle does not. A
+    // rectangle's heading repeats every 90 degrees.
+    // The search runs on at most ~1000 points (evenly strided); the extents use all of them.
+    std::vector<Point2> sample;
+    const std::size_t stride = footprint.size() / 1000 + 1;
+    for (std::size_t i = 0; i < footprint.size(); i += stride) sample.push_back(footprint[i]);
+    for (int deg = -45; deg < 45; ++deg) try_heading(static_cast<float>(deg) * kPi / 180.f, sample, trim_fraction);
+    const float heading = best_yaw;
+    best_area = 1e30f;
+    try_heading(heading, footprint, trim_fraction);
+  } else {
+    const std::vector<Point2> hull = ConvexHull(footprint);
+    // Minimum-area rectangle: one side lies on a hull edge (rotating calipers, O(h^2) is plenty
+    // for the hull sizes of single objects).
+    const std::size_t edges = hull.size() < 2 ? 1 : hull.size();
+    for (std::size_t e = 0; e < edges; ++e) {
+      float angle = 0.f;
+      if (hull.size() >= 2) {
+        const Point2 d = hull[(e + 1) % hull.size()] - hull[e];
+        angle = std::atan2(d.y(), d.x());
+      }
+      try_heading(angle, hull, 0.f);
+    }
   }
+
   Box3 box;
   float l = best_l, w = best_w;
   box.yaw_rad = CanonicalYaw(best_yaw, &l, &w, hint_yaw_rad);

@@ -44,13 +44,17 @@ struct TrackState_ {
 }  // namespace
 
 Detection Detection::FromBox(const Box3& box, const Atlas& atlas) {
+  return FromBox(box, atlas.Classify(box));
+}
+
+Detection Detection::FromBox(const Box3& box, const Classification& classification) {
   Detection d;
   d.xy_m = box.center.head<2>().cast<double>();
   d.yaw_rad = box.yaw_rad;
   d.length_m = std::max(box.size.x(), box.size.y());
   d.width_m = std::min(box.size.x(), box.size.y());
   d.height_m = box.size.z();
-  d.classification = atlas.Classify(box);
+  d.classification = classification;
   return d;
 }
 

@@ -154,6 +154,37 @@ TEST(BoxFitTest, CanonicalYawRules) {
   EXPECT_EQ(l, 1.0f);
 }
 
+TEST(BoxFitTest, TrimmedFitIgnoresStereoOutliers) {
+  mapping::SceneObject car;
+  car.center_xy = {9.f, 2.f};
+  car.size = {4.4f, 1.8f, 1.5f};
+  car.yaw_rad = 0.3f;
+  auto scene = Scene({car});
+  std::vector<int> idx = PointsOf(scene, 0);
+  // 2 % of the points scattered up to 1.5 m around the car (mismatches at its borders).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> off(-1.5f, 1.5f);
+  const int outliers = static_cast<int>(idx.size()) / 50;
+  const Eigen::Index n0 = scene.cloud.xyz.cols();
+  scene.cloud.xyz.conservativeResize(3, n0 + outliers);
+  for (int k = 0; k < outliers; ++k) {
+    const Eigen::Vector3f p = scene.cloud.xyz.col(idx[static_cast<std::size_t>(k * 37) % idx.size()]);
+    scene.cloud.xyz.col(n0 + k) = p + Eigen::Vector3f(off(rng), off(rng), 0.f);
+    idx.push_back(static_cast<int>(n0 + k));
+  }
+  const Box3 exact = FitVerticalBox(scene.cloud.xyz, idx);
+  const Box3 trimmed = FitVerticalBox(scene.cloud.xyz, idx, Eigen::Vector3f::UnitZ(), std::nullopt, 0.03f);
+  // The exact fit follows the outliers; trimming 3 % per end removes them. Trimming also cuts
+  // 3 % of the true surface points at each end: on a box surface sampled uniformly that shortens
+  // each extent by up to ~6 % (0.25 m on 4.4 m), hence the tolerances.
+  EXPECT_GT(exact.size.x(), 4.4f + 0.5f);
+  EXPECT_NEAR(trimmed.size.x(), 4.4f, 0.3f);
+  EXPECT_NEAR(trimmed.size.y(), 1.8f, 0.15f);
+  EXPECT_LT((trimmed.center.head<2>() - Eigen::Vector2f(9.f, 2.f)).norm(), 0.1f);
+  EXPECT_LT(AngleDiffHalfTurn(trimmed.yaw_rad, 0.3f), 2.f * kPi / 180.f);  // 1 degree search steps
+  EXPECT_THROW(FitVerticalBox(scene.cloud.xyz, idx, Eigen::Vector3f::UnitZ(), std::nullopt, 0.3f), romo::Error);
+}
+
 TEST(BoxFitTest, BadInputIsRejected) {
   Eigen::Matrix3Xf xyz(3, 2);
   xyz.col(0) = Eigen::Vector3f(1, 2, 3);

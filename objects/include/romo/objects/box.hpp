@@ -45,9 +45,12 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices);
 /// @param hint_yaw_rad previous heading of the same object (e.g. the track's yaw), optional.
 /// @throws romo::Error when @p indices is empty, out of range, names a non-finite point, or
 ///         @p up is not a unit vector.
+/// @param trim_fraction for noisy points (stereo at range): the fraction of points ignored at
+///        each end of every axis, and the heading is the one whose trimmed footprint rectangle
+///        is smallest (searched in 1 degree steps) instead of the exact hull's; 0 = exact fit.
 Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
                     const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ(),
-                    std::optional<float> hint_yaw_rad = std::nullopt);
+                    std::optional<float> hint_yaw_rad = std::nullopt, float trim_fraction = 0.f);
 
 /// Canonical heading for a footprint with extents (@p length_m, @p width_m) along a heading
 /// @p yaw_rad: swaps length/width so length >= width and returns the yaw in [-pi/2, pi/2); with

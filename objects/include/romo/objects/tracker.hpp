@@ -27,6 +27,8 @@ struct Detection {
 
   /// From a vertical box (centre xy, size, yaw) classified by @p atlas.
   static Detection FromBox(const Box3& box, const Atlas& atlas);
+  /// From a vertical box already classified (e.g. by ClassifyFromViewpoint).
+  static Detection FromBox(const Box3& box, const Classification& classification);
 };
 
 enum class TrackState {

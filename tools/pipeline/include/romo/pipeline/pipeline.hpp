@@ -21,8 +21,10 @@
 #include "romo/objects/box.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo/objects/tracker.hpp"
+#include "romo/objects/view_completion.hpp"
 #include "romo/planning_iface/messages.hpp"
 #include "romo/planning_iface/parking_slot.hpp"
+#include "romo/stereo/sgm.hpp"
 
 namespace romo::pipeline {
 
@@ -30,17 +32,24 @@ struct PipelineParams {
   int threads = 2;                ///< rigs matched in parallel (stereo), 1..64
   int disparity_size = 128;       ///< multiple of 16; 64 is enough at half resolution
   double max_range_m = 20.0;      ///< stereo points farther away are dropped
+  stereo::SgmParameters sgm = VehicleSgm();
   mapping::FusionParams fusion;
   mapping::GroundRemovalParams ground;
   mapping::SegmentationParams segmentation = DefaultSegmentation();
   /// Blobs whose box is lower than this are kerbs, lines and ground left-overs, not objects.
   double min_object_height_m = 0.5;
+  /// Stereo points ignored at each end of a box's axes (depth noise at range, see FitVerticalBox).
+  float box_trim_fraction = 0.03f;
+  /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
+  double max_ground_gap_m = 0.4;
+  objects::ViewCompletionParams completion;
   objects::TrackerParams tracker;
   objects::PredictorKind predictor = objects::PredictorKind::kRls;
   planning_iface::ParkingParams parking;
   std::string atlas_path;  ///< "" = objects::Atlas::DefaultPath()
 
   static mapping::SegmentationParams DefaultSegmentation();
+  static stereo::SgmParameters VehicleSgm();
   /// Defaults for @p calibration's image size (half-resolution images need half the disparity
   /// range for the same nearest depth) with @p threads stereo threads.
   static PipelineParams ForCalibration(const drivers::Calibration& calibration, int threads);

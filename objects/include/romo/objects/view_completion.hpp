@@ -1,0 +1,42 @@
+#pragma once
+/// Classification and completion of a vertical box seen from one viewpoint (dissertation 4.3.2:
+/// object completion from class knowledge). Stereo sees only the faces turned to the cameras, so
+/// along the line of sight a box's measured extent is only a lower bound of the object's; across
+/// it the extent is measured. The class (and which footprint axis is its length) that explains the
+/// measured extents best wins, the truncated extent is free up to the prior's maximum, and it is
+/// then grown to the prior's mean away from the viewer: the near face, which was seen, stays put.
+#include <Eigen/Core>
+
+#include "romo/objects/atlas.hpp"
+#include "romo/objects/box.hpp"
+
+namespace romo::objects {
+
+struct ViewCompletionParams {
+  /// A footprint axis within this angle of the line of sight has only its near face seen. At 45
+  /// degrees (a corner view) both faces are seen whole, so the angle must stay below 45.
+  double truncation_angle_deg = 40.0;
+  /// Objects nearer than this to the viewer are not completed (the line of sight is undefined).
+  double min_range_m = 0.5;
+  /// With a truncated extent, classes scoring within this factor of the best are equally likely
+  /// (the hidden depth says nothing): the one needing the least completion wins (a pedestrian
+  /// seen from the front is not completed into a cyclist).
+  double ambiguity_ratio = 1.5;
+};
+
+struct ViewedBox {
+  Classification classification;
+  Box3 box;                 ///< completed for classes with priors, the input box otherwise
+  bool completed = false;   ///< an extent was grown
+};
+
+/// @param box vertical box (yaw about z, size = extents along axes.col(0), col(1), height), in
+///        the same frame as @p viewer_xy (e.g. the vehicle frame with the cameras at its origin).
+/// @param depth_spread_m how much depth noise widened the extent along the line of sight (e.g.
+///        2 x 1.88 sigma_z for a fit that trims 3 % at each end): removed from the truncated
+///        extent before scoring, and the near face moves back by half of it.
+/// @throws romo::Error for non-finite extents or viewer, or a negative spread.
+ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
+                                const ViewCompletionParams& params = {}, double depth_spread_m = 0.0);
+
+}  // namespace romo::objects

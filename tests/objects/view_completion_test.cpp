@@ -1,0 +1,100 @@
+// Classification and completion of boxes seen from one viewpoint (only the near faces visible).
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "romo/core/check.hpp"
+#include "romo/objects/atlas.hpp"
+#include "romo/objects/view_completion.hpp"
+#include "test_support.hpp"
+
+namespace romo::objects {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+Atlas Load() { return Atlas::Load(test::SourcePath("config/atlas.yaml")); }
+
+std::string NameOf(const Atlas& atlas, const Classification& c) {
+  return atlas.classes()[static_cast<std::size_t>(c.class_index)].name;
+}
+
+Box3 MakeBox(Eigen::Vector2f center, float length, float width, float height, float yaw) {
+  Box3 b;
+  b.center = Eigen::Vector3f(center.x(), center.y(), height / 2);
+  b.size = Eigen::Vector3f(length, width, height);
+  b.yaw_rad = yaw;
+  b.axes.col(0) = Eigen::Vector3f(std::cos(yaw), std::sin(yaw), 0);
+  b.axes.col(1) = Eigen::Vector3f(-std::sin(yaw), std::cos(yaw), 0);
+  b.axes.col(2) = Eigen::Vector3f::UnitZ();
+  return b;
+}
+
+TEST(ViewCompletionTest, FrontOfACarIsCompletedAwayFromTheViewer) {
+  const Atlas atlas = Load();
+  const double car_length = atlas.classes()[atlas.Require("car")].length.mean_m;
+  // Stereo saw the front 0.5 m of a car whose front face is 11 m ahead: 1.8 m across the line of
+  // sight (box length axis along y), 0.5 m along it.
+  const Box3 seen = MakeBox({11.25f, 0.f}, 1.8f, 0.5f, 1.5f, kPi / 2);
+  const ViewedBox v = ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f::Zero());
+  EXPECT_EQ(NameOf(atlas, v.classification), "car");
+  ASSERT_TRUE(v.completed);
+  // The length now runs along the line of sight; the near face (x = 11) stays put.
+  EXPECT_NEAR(v.box.size.x(), car_length, 1e-5);
+  EXPECT_NEAR(v.box.size.y(), 1.8, 1e-5);
+  EXPECT_NEAR(v.box.center.x(), 11.0 + car_length / 2, 1e-5);
+  EXPECT_NEAR(v.box.center.y(), 0.0, 1e-5);
+  EXPECT_NEAR(std::abs(std::cos(v.box.yaw_rad)), 1.0, 1e-5);
+  // axes.col(0) still points along the (new) length and the frame stays right-handed.
+  EXPECT_NEAR(std::abs(v.box.axes.col(0).x()), 1.0, 1e-5);
+  EXPECT_NEAR(v.box.axes.col(0).cross(v.box.axes.col(1)).z(), 1.0, 1e-5);
+}
+
+TEST(ViewCompletionTest, SideOfACarBehindTheViewerGrowsBackwards) {
+  const Atlas atlas = Load();
+  const double car_width = atlas.classes()[atlas.Require("car")].width.mean_m;
+  // A car broadside 8 m behind (x = -8): its 4.3 m side seen, 0.4 m of its width.
+  const Box3 seen = MakeBox({-8.2f, 1.f}, 4.3f, 0.4f, 1.45f, kPi / 2);
+  const ViewedBox v = ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f::Zero());
+  EXPECT_EQ(NameOf(atlas, v.classification), "car");
+  ASSERT_TRUE(v.completed);
+  EXPECT_NEAR(v.box.size.y(), car_width, 1e-5);
+  EXPECT_NEAR(v.box.center.x(), -8.0 - car_width / 2, 1e-5);  // near face at x = -8 kept
+  EXPECT_NEAR(v.box.center.y(), 1.0, 1e-5);
+}
+
+TEST(ViewCompletionTest, PedestrianIsNotACarEvenWhenTruncated) {
+  const Atlas atlas = Load();
+  const ViewedBox v = ClassifyFromViewpoint(atlas, MakeBox({6.f, 2.f}, 0.5f, 0.3f, 1.75f, 1.2f),
+                                            Eigen::Vector2f::Zero());
+  EXPECT_EQ(NameOf(atlas, v.classification), "pedestrian");
+  // Shorter than the pedestrian mean along the line of sight: completed a little, never more
+  // than to the class mean.
+  EXPECT_LE(v.box.size.head<2>().maxCoeff(), atlas.classes()[atlas.Require("pedestrian")].length.mean_m + 1e-5);
+}
+
+TEST(ViewCompletionTest, CornerViewsAndImplausibleBoxesAreNotCompleted) {
+  const Atlas atlas = Load();
+  // Seen at 45 degrees both faces are visible whole: a 2 m x 1 m footprint is no car.
+  const ViewedBox corner =
+      ClassifyFromViewpoint(atlas, MakeBox({7.f, 7.f}, 2.0f, 1.0f, 1.5f, 0.f), Eigen::Vector2f::Zero());
+  EXPECT_NE(NameOf(atlas, corner.classification), "car");
+  EXPECT_FALSE(corner.completed);
+  // Wider across the line of sight than any class: unknown, box unchanged.
+  const Box3 wall = MakeBox({10.f, 0.f}, 9.0f, 0.5f, 1.4f, kPi / 2);
+  const ViewedBox w = ClassifyFromViewpoint(atlas, wall, Eigen::Vector2f::Zero());
+  EXPECT_EQ(NameOf(atlas, w.classification), "unknown");
+  EXPECT_FALSE(w.completed);
+  EXPECT_TRUE(w.box.center.isApprox(wall.center));
+}
+
+TEST(ViewCompletionTest, NonFiniteInputIsAnError) {
+  const Atlas atlas = Load();
+  Box3 b = MakeBox({5.f, 0.f}, 1.f, 1.f, 1.f, 0.f);
+  b.size.x() = NAN;
+  EXPECT_THROW(ClassifyFromViewpoint(atlas, b, Eigen::Vector2f::Zero()), romo::Error);
+}
+
+}  // namespace
+}  // namespace romo::objects
