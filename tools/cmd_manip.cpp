@@ -12,7 +12,9 @@
 #include "cli/command_registry.hpp"
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
+#include "romo/indoor_manip/knowledge.hpp"
 #include "romo/indoor_manip/manip_session.hpp"
+#include "romo/indoor_manip/object_functions.hpp"
 #include "romo/sim_manip/manip_eval.hpp"
 #include "romo/sim_manip/sim_manip.hpp"
 
@@ -91,10 +93,14 @@ struct ManipArgs {
   std::string lcm_url;
   std::string encapsulation = "pln";
   std::string intrinsics;
+  std::string object_functions;
   int max_frames = 0;
 };
 
 void RunManip(const ManipArgs& a) {
+  // The Atlas first: a broken file is reported before minutes of frames are processed.
+  const auto atlas = indoor_manip::ObjectFunctionAtlas::Load(
+      a.object_functions.empty() ? indoor_manip::ObjectFunctionAtlas::DefaultPath() : a.object_functions);
   indoor_manip::SessionOptions opt;
   opt.plane = indoor_manip::PlaneChoice::Parse(a.plane);
   opt.hand_seed = indoor_manip::ParsePixel(a.hand_seed, "--hand-seed");
@@ -117,6 +123,8 @@ void RunManip(const ManipArgs& a) {
 
   indoor_manip::WriteManipPlots(result, a.out);
   WriteText(a.out + "/label.json", indoor_manip::ManipResultJson(result));
+  const auto knowledge = indoor_manip::BuildKnowledge(result, atlas);
+  WriteText(a.out + "/knowledge.json", knowledge.ToJson());
   WriteText(a.out + "/path.csv", PathCsv(result));
   WriteText(a.out + "/profiles.csv", ProfilesCsv(result));
   const std::string url = a.lcm_url.empty() ? "file://" + a.out + "/manip.lcmlog?mode=w" : a.lcm_url;
@@ -130,8 +138,16 @@ void RunManip(const ManipArgs& a) {
   }
   std::printf("label: %s\n", result.decision.label.c_str());
   for (const auto& why : result.decision.reasons) std::printf("  because %s\n", why.c_str());
-  std::printf("frames: %d (hand missing in %d)\nwrote %s/{label.json,fingerprint.png,profiles.png,"
-              "rotation.png,path.csv,profiles.csv%s}\n",
+  for (const auto& f : knowledge.action.functions) {
+    std::printf("  object function: %s (%s plane): %s\n", f.object.c_str(), f.interaction_plane.c_str(),
+                f.pattern.c_str());
+  }
+  std::printf("plane: %d inlier points; %zu objects on it (octree DFS blobs, PCA boxes)\n",
+              result.scene.plane_inliers, result.scene.objects.size());
+  std::printf("location areas: %zu, transports: %zu\n", result.locations.areas.size(),
+              result.locations.transports.size());
+  std::printf("frames: %d (hand missing in %d)\nwrote %s/{label.json,knowledge.json,fingerprint.png,"
+              "profiles.png,rotation.png,path.csv,profiles.csv%s}\n",
               result.frames, result.frames_without_hand, a.out.c_str(),
               a.lcm_url.empty() ? ",manip.lcmlog" : "");
 }
@@ -141,6 +157,8 @@ struct EvalArgs {
   std::string actions = "all";
   int frames = 210;
   bool features = false;
+  bool json = false;
+  std::string png;
 };
 
 std::pair<int, int> ParseRange(const std::string& text) {
@@ -187,16 +205,17 @@ int RunEval(const EvalArgs& a) {
         const auto r = sim_manip::AnalyzeSimManip(o, params);
         label = r.decision.label;
         if (a.features) {
+          FILE* out = a.json ? stderr : stdout;  // keep stdout pure JSON
           if (!header) {
-            std::printf("%-12s %4s %-12s", "action", "seed", "label");
-            for (const auto& [name, v] : r.features.Named()) std::printf(" %s", name.c_str());
-            std::printf("\n");
+            std::fprintf(out, "%-12s %4s %-12s", "action", "seed", "label");
+            for (const auto& [name, v] : r.features.Named()) std::fprintf(out, " %s", name.c_str());
+            std::fprintf(out, "\n");
             header = true;
           }
-          std::printf("%-12s %4d %-12s", action.c_str(), seed, label.c_str());
-          for (const auto& [name, v] : r.features.Named()) std::printf(" %.4g", v);
-          std::printf("\n");
-          std::fflush(stdout);
+          std::fprintf(out, "%-12s %4d %-12s", action.c_str(), seed, label.c_str());
+          for (const auto& [name, v] : r.features.Named()) std::fprintf(out, " %.4g", v);
+          std::fprintf(out, "\n");
+          std::fflush(out);
         }
       } catch (const romo::Error& e) {
         std::fprintf(stderr, "%s seed %d: %s\n", action.c_str(), seed, e.what());
@@ -206,6 +225,17 @@ int RunEval(const EvalArgs& a) {
     }
   }
   progress.Finish();
+  char title[128];
+  std::snprintf(title, sizeof(title), "romo eval manip: seeds %d-%d, %d frames (rows truth)", s0, s1, a.frames);
+  if (!a.png.empty()) sim_manip::WriteConfusionPng(cm, a.png, title);
+  if (a.json) {
+    std::string json = cm.ToJson();
+    // Which seeds: the thresholds were chosen on others.
+    json.insert(4, "\"seeds\": [" + std::to_string(s0) + ", " + std::to_string(s1) + "],\n  \"frames\": " +
+                       std::to_string(a.frames) + ",\n  ");
+    std::printf("%s", json.c_str());
+    return 0;
+  }
   std::printf("confusion matrix, seeds %d-%d, %d frames each (rows truth, columns predicted):\n%s",
               s0, s1, a.frames, cm.ToText().c_str());
   std::printf("accuracy %.3f over %d runs\n", cm.Accuracy(), cm.Total());
@@ -235,6 +265,8 @@ const bool kRegistered = RegisterCommand([](CLI::App& root) {
   cmd->add_option("--encapsulation", args->encapsulation, "pln (plane axes) or pca")->capture_default_str();
   cmd->add_option("--intrinsics", args->intrinsics, "depth camera fx,fy,cx,cy (default: the source's)");
   cmd->add_option("--max-frames", args->max_frames, "stop after N frames (0 = all)")->capture_default_str();
+  cmd->add_option("--object-functions", args->object_functions,
+                  "Atlas of object functions (YAML; default config/object_functions.yaml or $ROMO_OBJECT_FUNCTIONS)");
   cmd->callback([args] { RunManip(*args); });
 
   auto eval = std::make_shared<EvalArgs>();
@@ -244,6 +276,8 @@ const bool kRegistered = RegisterCommand([](CLI::App& root) {
   ev->add_option("--actions", eval->actions, "comma-separated actions or 'all'")->capture_default_str();
   ev->add_option("--frames", eval->frames, "frames per scene")->capture_default_str()->check(CLI::Range(30, 5000));
   ev->add_flag("--features", eval->features, "print the features of every run");
+  ev->add_flag("--json", eval->json, "print the confusion matrix as JSON (per-action recall/precision, pairs)");
+  ev->add_option("--png", eval->png, "also draw the confusion matrix into this PNG");
   ev->callback([eval] { RunEval(*eval); });
 });
 
