@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "romo/core/check.hpp"
+#include "romo/core/text_file.hpp"
 #include "romo/drivers/gige.hpp"
 
 namespace romo::drivers {
@@ -156,11 +157,8 @@ std::string GigeCameraRef::Describe() const {
 }
 
 GigeConfig GigeConfig::Load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Fail(path + ": cannot open rig configuration (missing or unreadable)");
-  std::stringstream text;
-  text << in.rdbuf();
-  return FromYaml(text.str(), path, fs::path(path).parent_path().string());
+  const std::string text = ReadWholeFile(path, path + ": cannot open rig configuration (missing or unreadable)");
+  return FromYaml(text, path, fs::path(path).parent_path().string());
 }
 
 GigeConfig GigeConfig::FromYaml(const std::string& yaml_text, const std::string& origin,

@@ -9,6 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "romo/core/check.hpp"
+#include "romo/core/text_file.hpp"
 #include "romo/indoor_manip/action_label.hpp"
 
 #ifndef ROMO_DEFAULT_OBJECT_FUNCTIONS
@@ -63,11 +64,7 @@ std::string ObjectFunctionAtlas::DefaultPath() {
 }
 
 ObjectFunctionAtlas ObjectFunctionAtlas::Load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) Fail("object functions '" + path + "': cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return Parse(text.str(), path);
+  return Parse(ReadWholeFile(path, "object functions '" + path + "': cannot open file"), path);
 }
 
 ObjectFunctionAtlas ObjectFunctionAtlas::Parse(const std::string& yaml_text, const std::string& source) {

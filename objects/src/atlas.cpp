@@ -9,6 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "romo/core/check.hpp"
+#include "romo/core/text_file.hpp"
 
 #ifndef ROMO_DEFAULT_ATLAS
 #define ROMO_DEFAULT_ATLAS "config/atlas.yaml"
@@ -81,11 +82,7 @@ std::string Atlas::DefaultPath() {
 }
 
 Atlas Atlas::Load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) Fail("atlas '" + path + "': cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return Parse(text.str(), path);
+  return Parse(ReadWholeFile(path, "atlas '" + path + "': cannot open file"), path);
 }
 
 Atlas Atlas::Parse(const std::string& yaml_text, const std::string& source) {
