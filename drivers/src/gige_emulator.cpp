@@ -46,7 +46,8 @@ class GigeEmulator::Impl {
     if (!(rate_hz > 0.0 && rate_hz <= 1000.0)) {
       Fail("gige emulator: rate " + std::to_string(rate_hz) + " Hz must be in (0, 1000]");
     }
-    period_ns_ = static_cast<std::int64_t>(1e9 / rate_hz);
+    // Whole microseconds: the fake camera's period register, and so its wake-up grid, is in µs.
+    period_ns_ = 1000 * static_cast<std::int64_t>(1e6 / rate_hz);
     for (auto& camera : cameras) {
       const std::string what = "gige emulator: camera " + camera.serial + " at " + camera.address;
       if (camera.serial.empty() || camera.serial.size() > 15) {
@@ -155,15 +156,12 @@ class GigeEmulator::Impl {
                    ArvPixelFormat pixel_format) {
     auto* served = static_cast<Served*>(data);
     Impl* self = served->owner;
-    // Every fake camera wakes on the same multiples of the frame period: the first fill fixes the
-    // phase and tick 0, later fills round to the nearest tick, so all cameras agree on the index.
+    // Aravis' fake camera wakes on multiples of its frame period in real time and stamps the fill
+    // with the real time it actually ran, so a starved thread is only ever late. Flooring to the
+    // grid point it woke for (not rounding to the nearest) keeps a frame up to a whole period late
+    // on its own tick: stamps never repeat, and every camera agrees on the recording index.
     const auto stamp = static_cast<std::int64_t>(arv_buffer_get_timestamp(buffer));
-    std::int64_t phase = self->phase_ns_.load();
-    if (phase == LLONG_MIN) {
-      self->phase_ns_.compare_exchange_strong(phase, stamp % self->period_ns_);
-      phase = self->phase_ns_.load();
-    }
-    const std::int64_t tick = (stamp - phase + self->period_ns_ / 2) / self->period_ns_;
+    const std::int64_t tick = stamp / self->period_ns_;
     std::int64_t first = self->first_tick_.load();
     if (first == LLONG_MIN) {
       self->first_tick_.compare_exchange_strong(first, tick);
@@ -191,7 +189,7 @@ class GigeEmulator::Impl {
       std::memset(out, 0, row_bytes * height);
       ++served->mismatched;
     }
-    arv_buffer_set_timestamp(buffer, static_cast<guint64>(phase + tick * self->period_ns_ +
+    arv_buffer_set_timestamp(buffer, static_cast<guint64>(tick * self->period_ns_ +
                                                           self->ShiftAt(tick)));
     ++served->served;
   }
@@ -211,7 +209,6 @@ class GigeEmulator::Impl {
   std::atomic<std::int64_t> latest_tick_{LLONG_MIN};
   std::mutex shift_mutex_;
   std::vector<std::pair<std::int64_t, std::int64_t>> shifts_;  // (from tick, offset ns)
-  std::atomic<std::int64_t> phase_ns_{LLONG_MIN};
   std::atomic<std::int64_t> first_tick_{LLONG_MIN};
   std::vector<std::unique_ptr<Served>> cameras_;
 };
