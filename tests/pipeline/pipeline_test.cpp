@@ -8,6 +8,8 @@
 
 #include "romo/core/check.hpp"
 #include "romo/drivers/calibration.hpp"
+#include "romo/drivers/recording.hpp"
+#include "romo/planning_iface/messages.hpp"
 #include "test_support.hpp"
 
 namespace romo::pipeline {
@@ -89,6 +91,48 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   romo::test::WriteFile(dir / "empty.lcmlog", "");
   const auto bad = romo::test::RunRomo("replay " + (dir / "empty.lcmlog") + " --out " + (dir / "x"));
   EXPECT_NE(bad.exit_code, 0);
+}
+
+// A recording cut inside its last frame set (power lost while writing): replay processes every
+// complete image, the cut set with the rigs that made it into the file, and says where the file
+// ends: on stderr, in summary.json and in the perception status of the frame it cut.
+TEST(PipelineTest, ReplayOfATruncatedRecordingReportsTheCutInThePerceptionStatus) {
+  romo::test::ScratchDir dir;
+  const auto sim = romo::test::RunRomo("sim --scene parking --seed 11 --frames 3 --first 60 --scale 0.25 --out " +
+                                       (dir / "run.lcmlog"));
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::string whole = romo::test::ReadFile(dir / "run.lcmlog");
+  // A set is written as rigs 0-5 (57 kB each at this scale), vehicle state, GNSS, ground truth
+  // (2 kB): 5000 bytes off the end cut into the last set's rig 5 image.
+  romo::test::WriteFile(dir / "cut.lcmlog", whole.substr(0, whole.size() - 5000));
+  const auto replay = romo::test::RunRomo("replay " + (dir / "cut.lcmlog") + " --no-pictures --out " + (dir / "out"));
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  EXPECT_NE(replay.err.find("truncated at byte"), std::string::npos) << replay.err;
+
+  std::vector<planning_iface::PerceptionStatus> statuses;
+  for (const auto& e : drivers::ReadAllEvents(dir / "out/outputs.lcmlog", nullptr)) {
+    if (e.channel != planning_iface::kPerceptionStatusChannel) continue;
+    std::string why;
+    const auto status = planning_iface::DecodePerceptionStatus(e.data.data(), e.data.size(), &why);
+    ASSERT_TRUE(status) << why;
+    statuses.push_back(*status);
+  }
+  ASSERT_EQ(statuses.size(), 3u);
+  const auto reports_cut = [](const planning_iface::PerceptionStatus& status) {
+    for (const auto& event : status.events) {
+      if (event.find("cut.lcmlog: log truncated at byte") != std::string::npos) return true;
+    }
+    return false;
+  };
+  EXPECT_FALSE(reports_cut(statuses[0]));
+  EXPECT_FALSE(reports_cut(statuses[1]));
+  EXPECT_TRUE(reports_cut(statuses[2]));
+  int present = 0;
+  for (const auto& rig : statuses[2].rigs) present += rig.present ? 1 : 0;
+  EXPECT_EQ(present, 5);  // rig 5's image was cut
+  EXPECT_FALSE(statuses[2].rigs.back().present);
+  const std::string summary = romo::test::ReadFile(dir / "out/summary.json");
+  EXPECT_NE(summary.find("truncated at byte"), std::string::npos) << summary;
 }
 
 }  // namespace

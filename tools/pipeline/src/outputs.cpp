@@ -51,6 +51,14 @@ class OutputSink::Impl {
   std::optional<pi::ParkingSlot> best_slot;
   std::int64_t frames_with_feasible_slot = 0;
   std::int64_t dropped = 0, malformed = 0;
+
+  void RecordStatus(const pi::PerceptionStatus& status) {
+    for (const auto& e : status.events) {
+      if (events.size() < 200) events.push_back("frame " + std::to_string(status.frame_sequence) + ": " + e);
+    }
+    dropped = status.frames_dropped;
+    malformed = status.malformed_messages;
+  }
 };
 
 OutputSink::OutputSink(const drivers::Calibration& calibration, const OutputOptions& options)
@@ -120,11 +128,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
   s.max_tracks = std::max<std::int64_t>(s.max_tracks, static_cast<std::int64_t>(r.tracks.size()));
   for (const auto& t : r.tracks) s.track_ids.insert(t.id);
   for (const auto& p : r.predictions) s.pedestrian_ids.insert(p.track_id);
-  for (const auto& e : r.status.events) {
-    if (s.events.size() < 200) s.events.push_back("frame " + std::to_string(r.frame_sequence) + ": " + e);
-  }
-  s.dropped = r.status.frames_dropped;
-  s.malformed = r.status.malformed_messages;
+  s.RecordStatus(r.status);
   bool feasible = false;
   for (const auto& slot : r.slots.slots) {
     if (slot.feasible) {
@@ -143,6 +147,14 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
     sum.trail.push_back(r.ego_world.position_m);
     sum.last = r;
   }
+}
+
+void OutputSink::WriteStatus(const pi::PerceptionStatus& status) {
+  Impl& s = *impl_;
+  const std::vector<std::uint8_t> bytes = pi::Encode(status);
+  if (s.log) s.log->WriteRaw(pi::kPerceptionStatusChannel, status.stamp_ns, bytes.data(), bytes.size());
+  if (s.bus) s.bus->Publish(pi::kPerceptionStatusChannel, bytes);
+  s.RecordStatus(status);
 }
 
 void OutputSink::Finish(const std::string& extra_json) {

@@ -157,6 +157,7 @@ class Pipeline::Impl {
   std::int64_t frames_dropped = 0;
   std::int64_t malformed = 0;
   std::vector<std::string> events;
+  planning_iface::PerceptionStatus last_status;  // without events
 };
 
 Pipeline::Pipeline(const drivers::Calibration& calibration, const PipelineParams& params) {
@@ -177,6 +178,16 @@ void Pipeline::CountDropped(int rig_id) {
 }
 void Pipeline::CountMalformed() { ++impl_->malformed; }
 void Pipeline::ReportEvent(const std::string& event) { impl_->events.push_back(event); }
+
+std::optional<planning_iface::PerceptionStatus> Pipeline::TakePendingStatus() {
+  Impl& s = *impl_;
+  if (s.events.empty()) return std::nullopt;
+  planning_iface::PerceptionStatus status = s.last_status;
+  status.frames_dropped = s.frames_dropped;
+  status.malformed_messages = s.malformed;
+  status.events.swap(s.events);
+  return status;
+}
 
 namespace {
 RigInput ToInput(const stereo::RigResult& rr, std::int64_t stamp_ns) {
@@ -467,6 +478,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   r.status.frames_processed = s.frames_processed;
   r.status.frames_dropped = s.frames_dropped;
   r.status.malformed_messages = s.malformed;
+  s.last_status = r.status;
   r.status.events = std::move(events);
   return r;
 }

@@ -1,5 +1,6 @@
 #include "romo/pipeline/run_loop.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -54,6 +55,14 @@ RunStats RunFrames(drivers::FrameSource& source, Pipeline& pipeline, OutputSink&
   RunStats stats;
   const auto start = Clock::now();
   std::optional<std::int64_t> first_stamp, last_stamp;
+  // The source's own events (damaged or dropped messages, a truncated recording) go into the
+  // perception status with the frame they came before, or into a last status at the end.
+  std::size_t source_events_reported = 0;
+  const auto report_source_events = [&] {
+    const std::vector<std::string> events = source.status().events;
+    for (std::size_t i = source_events_reported; i < events.size(); ++i) pipeline.ReportEvent("source: " + events[i]);
+    source_events_reported = std::max(source_events_reported, events.size());
+  };
   while (options.max_frames <= 0 || stats.frames < options.max_frames) {
     if (options.duration_s > 0.0 &&
         std::chrono::duration<double>(Clock::now() - start).count() >= options.duration_s) {
@@ -77,12 +86,14 @@ RunStats RunFrames(drivers::FrameSource& source, Pipeline& pipeline, OutputSink&
       const auto due = start + std::chrono::nanoseconds(frames->stamp_ns - *first_stamp);
       std::this_thread::sleep_until(due);
     }
-    for (const auto& e : source.status().events) (void)e;
+    report_source_events();
     const FrameResult result = pipeline.Process(*frames);
     outputs.Write(&*frames, result, extra);
     ++stats.frames;
     if (progress) progress(stats.frames, result);
   }
+  report_source_events();
+  if (auto status = pipeline.TakePendingStatus()) outputs.WriteStatus(*status);
   stats.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   return stats;
 }

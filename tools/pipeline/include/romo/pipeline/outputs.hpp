@@ -40,6 +40,10 @@ class OutputSink {
   void Write(const drivers::FrameSet* inputs, const FrameResult& result,
              const std::vector<drivers::LogEvent>& passthrough);
 
+  /// Publishes and logs a status without a frame (faults found after the last frame); its events
+  /// also go into summary.json.
+  void WriteStatus(const planning_iface::PerceptionStatus& status);
+
   /// Writes the stage summaries and summary.json, closes files. Idempotent.
   /// @param extra JSON members (without braces) added to summary.json, e.g. "\"source\":\"x\"".
   void Finish(const std::string& extra_json = "");

@@ -119,6 +119,9 @@ class Pipeline {
   void CountMalformed();
   /// Adds a line to the next status' events.
   void ReportEvent(const std::string& event);
+  /// The last frame's status carrying the events reported since it, for faults found when no
+  /// frame follows (a recording truncated after its last complete frame); nullopt if none pending.
+  std::optional<planning_iface::PerceptionStatus> TakePendingStatus();
 
   const drivers::Calibration& calibration() const;
   const PipelineParams& params() const;
