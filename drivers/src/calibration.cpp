@@ -1,16 +1,25 @@
-// Calibration I/O through OpenCV FileStorage YAML, with every field checked on the way in.
+// Calibration I/O: OpenCV FileStorage-style YAML (%YAML:1.0, !!opencv-matrix), read with yaml-cpp
+// and written here, with every field checked on the way in. Not read with cv::FileStorage: OpenCV
+// 4.6's YAML parser spins for minutes on some 129-byte documents, and recordings carry this text.
 #include "romo/drivers/calibration.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <locale>
+#include <optional>
+#include <ostream>
 #include <set>
 #include <sstream>
 #include <dlfcn.h>
 #include <sys/stat.h>
 
-#include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "romo/core/check.hpp"
+#include "romo/core/text_file.hpp"
 
 namespace romo::drivers {
 namespace {
@@ -21,6 +30,9 @@ constexpr double kOrthonormalTolerance = 1e-5;
 constexpr double kMinBaselineM = 1e-3;
 // Number of coefficients OpenCV accepts for a distortion model.
 const std::set<std::size_t> kDistortionSizes = {0, 4, 5, 8, 12, 14};
+// Six rigs take ~6 KB; the cap keeps yaml-cpp's per-node memory (~100 B each) bounded for
+// hostile text (a recording's calibration message, a fuzzed file).
+constexpr std::size_t kMaxCalibrationBytes = std::size_t{1} << 20;
 
 std::string Num(double value) {
   if (std::isnan(value)) return "nan";
@@ -35,75 +47,196 @@ std::string Num(double value) {
   Fail(origin + ": " + field + ": " + what);
 }
 
-std::string NodeKind(const cv::FileNode& node) {
-  if (node.isNone()) return "missing";
-  if (node.isInt()) return "an integer";
-  if (node.isReal()) return "a number";
-  if (node.isString()) return "the text '" + static_cast<std::string>(node) + "'";
-  if (node.isSeq()) return "a sequence";
-  if (node.isMap()) return "a map";
-  return "an unknown node";
+// --- Scalars, typed the way OpenCV's reader types them (plain 12 is an integer, 12. a number,
+// anything quoted is text), so files FileStorage read load to the same values. ---
+
+bool IsQuoted(const YAML::Node& node) { return node.Tag() == "!"; }
+
+std::optional<long long> ParseInteger(const std::string& s) {
+  std::size_t start = (!s.empty() && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+  if (start == s.size()) return std::nullopt;
+  for (std::size_t i = start; i < s.size(); ++i) {
+    if (s[i] < '0' || s[i] > '9') return std::nullopt;
+  }
+  long long value = 0;
+  // from_chars rejects '+'; a leading '-' it handles itself.
+  const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
+  const auto result = std::from_chars(begin, s.data() + s.size(), value);
+  if (result.ec != std::errc() || result.ptr != s.data() + s.size()) return std::nullopt;
+  return value;
 }
 
-int ReadInt(const cv::FileNode& parent, const char* key, const std::string& origin,
-            const std::string& field) {
-  const cv::FileNode node = parent[key];
-  if (node.isNone()) FieldError(origin, field, "missing");
-  if (!node.isInt()) FieldError(origin, field, "expected an integer, got " + NodeKind(node));
-  return static_cast<int>(node);
-}
-
-std::string ReadString(const cv::FileNode& parent, const char* key, const std::string& origin,
-                       const std::string& field) {
-  const cv::FileNode node = parent[key];
-  if (node.isNone()) FieldError(origin, field, "missing");
-  if (!node.isString()) FieldError(origin, field, "expected text, got " + NodeKind(node));
-  return static_cast<std::string>(node);
-}
-
-// Reads an !!opencv-matrix (or a plain sequence of numbers, as a 1xN row) into doubles.
-cv::Mat ReadMat(const cv::FileNode& parent, const char* key, const std::string& origin,
-                const std::string& field) {
-  const cv::FileNode node = parent[key];
-  if (node.isNone()) FieldError(origin, field, "missing");
-  cv::Mat mat;
-  try {
-    if (node.isSeq()) {
-      std::vector<double> values;
-      for (const auto& item : node) {
-        if (!item.isInt() && !item.isReal()) {
-          FieldError(origin, field, "expected numbers, got " + NodeKind(item));
-        }
-        values.push_back(static_cast<double>(item));
-      }
-      if (!values.empty()) mat = cv::Mat(values, true).reshape(1, 1);
-    } else if (node.isMap()) {
-      // OpenCV allocates rows x cols before it counts the data (a one-line corrupt size asked
-      // for 48 GB): the declared size must not exceed the numbers given.
-      const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
-      if (!rows.isInt() || !cols.isInt() || !data.isSeq() || static_cast<int>(rows) < 0 ||
-          static_cast<int>(cols) < 0 ||
-          static_cast<double>(static_cast<int>(rows)) * static_cast<int>(cols) >
-              static_cast<double>(data.size())) {
-        FieldError(origin, field, "opencv-matrix rows x cols do not match its data");
-      }
-      node >> mat;
+std::optional<double> ParseReal(const std::string& s) {
+  // YAML's and OpenCV's spellings of the special values (OpenCV writes .Nan, .Inf, -.Inf).
+  std::string lower;
+  for (char c : s) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  if (lower == ".nan") return std::numeric_limits<double>::quiet_NaN();
+  if (lower == ".inf" || lower == "+.inf") return std::numeric_limits<double>::infinity();
+  if (lower == "-.inf") return -std::numeric_limits<double>::infinity();
+  // Only decimal notation: from_chars alone would also take "inf", "nan" and hex floats.
+  bool has_digit = false;
+  for (char c : s) {
+    if (c >= '0' && c <= '9') {
+      has_digit = true;
+    } else if (c != '+' && c != '-' && c != '.' && c != 'e' && c != 'E') {
+      return std::nullopt;
     }
-  } catch (const cv::Exception& e) {
-    FieldError(origin, field, std::string("not a matrix: ") + e.what());
   }
-  if (mat.empty() && !node.isSeq()) {
-    FieldError(origin, field, "expected a matrix, got " + NodeKind(node));
+  if (!has_digit) return std::nullopt;
+  double value = 0;
+  const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
+  const auto result = std::from_chars(begin, s.data() + s.size(), value);
+  // Out of range ("1e999") is an error of from_chars; OpenCV's strtod gives +-inf, which the
+  // finiteness checks then name.
+  if (result.ec == std::errc::result_out_of_range && result.ptr == s.data() + s.size()) {
+    return s[0] == '-' ? -std::numeric_limits<double>::infinity()
+                       : std::numeric_limits<double>::infinity();
   }
-  if (!mat.empty()) mat.convertTo(mat, CV_64F);
+  if (result.ec != std::errc() || result.ptr != s.data() + s.size()) return std::nullopt;
+  return value;
+}
+
+std::optional<int> AsInt(const YAML::Node& node) {
+  if (!node.IsScalar() || IsQuoted(node)) return std::nullopt;
+  const auto value = ParseInteger(node.Scalar());
+  if (!value || *value < std::numeric_limits<int>::min() ||
+      *value > std::numeric_limits<int>::max()) {
+    return std::nullopt;
+  }
+  return static_cast<int>(*value);
+}
+
+std::optional<double> AsNumber(const YAML::Node& node) {
+  if (!node.IsScalar() || IsQuoted(node)) return std::nullopt;
+  if (const auto integer = ParseInteger(node.Scalar())) return static_cast<double>(*integer);
+  return ParseReal(node.Scalar());
+}
+
+std::string NodeKind(const YAML::Node& node) {
+  if (!node.IsDefined()) return "missing";
+  if (node.IsNull()) return "nothing";
+  if (node.IsSequence()) return "a sequence";
+  if (node.IsMap()) return "a map";
+  if (AsInt(node)) return "an integer";
+  if (AsNumber(node)) return "the number " + node.Scalar();
+  return "the text '" + node.Scalar() + "'";
+}
+
+// A key of a map node; missing for anything else (yaml-cpp's const operator[] throws on
+// scalars, and a non-const one would insert).
+YAML::Node Child(const YAML::Node& parent, const char* key) {
+  if (!parent.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
+  const YAML::Node& const_parent = parent;
+  return const_parent[key];
+}
+
+int ReadInt(const YAML::Node& parent, const char* key, const std::string& origin,
+            const std::string& field) {
+  const YAML::Node node = Child(parent, key);
+  if (!node.IsDefined()) FieldError(origin, field, "missing");
+  const auto value = AsInt(node);
+  if (!value) FieldError(origin, field, "expected an integer, got " + NodeKind(node));
+  return *value;
+}
+
+std::string ReadString(const YAML::Node& parent, const char* key, const std::string& origin,
+                       const std::string& field) {
+  const YAML::Node node = Child(parent, key);
+  if (!node.IsDefined()) FieldError(origin, field, "missing");
+  if (!node.IsScalar() || (!IsQuoted(node) && AsNumber(node))) {
+    FieldError(origin, field, "expected text, got " + NodeKind(node));
+  }
+  return node.Scalar();
+}
+
+// A matrix read from YAML, row-major.
+struct Matrix {
+  int rows = 0;
+  int cols = 0;
+  std::vector<double> values;
+  double at(int r, int c) const { return values[static_cast<std::size_t>(r) * cols + c]; }
+};
+
+std::vector<double> ReadNumbers(const YAML::Node& seq, const std::string& origin,
+                                const std::string& field) {
+  std::vector<double> values;
+  values.reserve(seq.size());
+  for (const auto& item : seq) {
+    const auto value = AsNumber(item);
+    if (!value) FieldError(origin, field, "expected numbers, got " + NodeKind(item));
+    values.push_back(*value);
+  }
+  return values;
+}
+
+// Element types of an opencv-matrix (dt); values are stored as that type, so a file whose dt is
+// f or an integer type loads with the rounding FileStorage applied.
+double StoreAs(char dt, double value) {
+  const auto saturate = [&](double lo, double hi) {
+    return std::isnan(value) ? 0.0 : std::min(hi, std::max(lo, std::nearbyint(value)));
+  };
+  switch (dt) {
+    case 'u': return saturate(0, 255);
+    case 'c': return saturate(-128, 127);
+    case 'w': return saturate(0, 65535);
+    case 's': return saturate(-32768, 32767);
+    case 'i': return saturate(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+    case 'f': return static_cast<double>(static_cast<float>(value));
+    default: return value;  // 'd'
+  }
+}
+
+// Reads an !!opencv-matrix (or a plain sequence of numbers, as a 1xN row).
+Matrix ReadMat(const YAML::Node& parent, const char* key, const std::string& origin,
+               const std::string& field) {
+  const YAML::Node node = Child(parent, key);
+  if (!node.IsDefined()) FieldError(origin, field, "missing");
+  Matrix mat;
+  if (node.IsSequence()) {
+    mat.values = ReadNumbers(node, origin, field);
+    if (!mat.values.empty()) {
+      mat.rows = 1;
+      mat.cols = static_cast<int>(mat.values.size());
+    }
+    return mat;
+  }
+  if (!node.IsMap()) FieldError(origin, field, "expected a matrix, got " + NodeKind(node));
+  const YAML::Node rows = Child(node, "rows"), cols = Child(node, "cols");
+  const YAML::Node dt = Child(node, "dt"), data = Child(node, "data");
+  const auto r = AsInt(rows), c = AsInt(cols);
+  if (!r || *r < 0) FieldError(origin, field + ".rows", "expected a count, got " + NodeKind(rows));
+  if (!c || *c < 0) FieldError(origin, field + ".cols", "expected a count, got " + NodeKind(cols));
+  // Single-channel element types only: a calibration matrix has one number per element.
+  const std::string type = dt.IsScalar() ? dt.Scalar() : "";
+  if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos) {
+    FieldError(origin, field + ".dt",
+               "expected one of u, c, w, s, i, f, d, got " + NodeKind(dt));
+  }
+  if (!data.IsSequence()) {
+    FieldError(origin, field + ".data", "expected a sequence, got " + NodeKind(data));
+  }
+  mat.values = ReadNumbers(data, origin, field + ".data");
+  if (static_cast<double>(*r) * *c != static_cast<double>(mat.values.size())) {
+    FieldError(origin, field,
+               "opencv-matrix rows x cols = " + std::to_string(*r) + "x" + std::to_string(*c) +
+                   " does not match its " + std::to_string(mat.values.size()) + " numbers");
+  }
+  for (double& value : mat.values) value = StoreAs(type[0], value);
+  if (!mat.values.empty()) {
+    mat.rows = *r;
+    mat.cols = *c;
+  }
   return mat;
 }
 
-cv::Mat ReadMatSized(const cv::FileNode& parent, const char* key, int rows, int cols,
-                     const std::string& origin, const std::string& field) {
-  cv::Mat mat = ReadMat(parent, key, origin, field);
+Matrix ReadMatSized(const YAML::Node& parent, const char* key, int rows, int cols,
+                    const std::string& origin, const std::string& field) {
+  Matrix mat = ReadMat(parent, key, origin, field);
   // Hand-written files may give a plain row-major list of numbers instead of an opencv-matrix.
-  if (mat.rows == 1 && mat.cols == rows * cols) mat = mat.reshape(1, rows).clone();
+  if (mat.rows == 1 && mat.cols == rows * cols) {
+    mat.rows = rows;
+    mat.cols = cols;
+  }
   if (mat.rows != rows || mat.cols != cols) {
     FieldError(origin, field,
                "expected a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix, got " +
@@ -111,9 +244,9 @@ cv::Mat ReadMatSized(const cv::FileNode& parent, const char* key, int rows, int 
   }
   for (int r = 0; r < mat.rows; ++r) {
     for (int c = 0; c < mat.cols; ++c) {
-      if (!std::isfinite(mat.at<double>(r, c))) {
+      if (!std::isfinite(mat.at(r, c))) {
         FieldError(origin, field, "element (" + std::to_string(r) + "," + std::to_string(c) +
-                                      ") = " + Num(mat.at<double>(r, c)) + " is not finite");
+                                      ") = " + Num(mat.at(r, c)) + " is not finite");
       }
     }
   }
@@ -121,47 +254,91 @@ cv::Mat ReadMatSized(const cv::FileNode& parent, const char* key, int rows, int 
 }
 
 template <typename Derived>
-void CopyTo(const cv::Mat& mat, Eigen::MatrixBase<Derived>* out) {
+void CopyTo(const Matrix& mat, Eigen::MatrixBase<Derived>* out) {
   for (int r = 0; r < mat.rows; ++r) {
-    for (int c = 0; c < mat.cols; ++c) (*out)(r, c) = mat.at<double>(r, c);
+    for (int c = 0; c < mat.cols; ++c) (*out)(r, c) = mat.at(r, c);
   }
 }
 
-template <typename Derived>
-cv::Mat ToMat(const Eigen::MatrixBase<Derived>& m) {
-  cv::Mat mat(static_cast<int>(m.rows()), static_cast<int>(m.cols()), CV_64F);
-  for (int r = 0; r < mat.rows; ++r) {
-    for (int c = 0; c < mat.cols; ++c) mat.at<double>(r, c) = m(r, c);
-  }
-  return mat;
-}
-
-CameraIntrinsics ReadCamera(const cv::FileNode& node, const std::string& origin,
+CameraIntrinsics ReadCamera(const YAML::Node& parent, const char* key, const std::string& origin,
                             const std::string& field) {
-  if (node.isNone()) FieldError(origin, field, "missing");
-  if (!node.isMap()) FieldError(origin, field, "expected a map, got " + NodeKind(node));
+  const YAML::Node node = Child(parent, key);
+  if (!node.IsDefined()) FieldError(origin, field, "missing");
+  if (!node.IsMap()) FieldError(origin, field, "expected a map, got " + NodeKind(node));
   CameraIntrinsics camera;
   CopyTo(ReadMatSized(node, "K", 3, 3, origin, field + ".K"), &camera.K);
-  const cv::FileNode dist = node["distortion"];
-  if (dist.isNone()) FieldError(origin, field + ".distortion", "missing (write [] for none)");
-  const cv::Mat d = ReadMat(node, "distortion", origin, field + ".distortion");
-  if (!d.empty() && d.rows != 1 && d.cols != 1) {
+  if (!Child(node, "distortion").IsDefined()) {
+    FieldError(origin, field + ".distortion", "missing (write [] for none)");
+  }
+  const Matrix d = ReadMat(node, "distortion", origin, field + ".distortion");
+  if (!d.values.empty() && d.rows != 1 && d.cols != 1) {
     FieldError(origin, field + ".distortion",
                "expected a vector, got " + std::to_string(d.rows) + "x" + std::to_string(d.cols));
   }
-  for (int i = 0; i < static_cast<int>(d.total()); ++i) {
-    camera.distortion.push_back(d.at<double>(d.rows == 1 ? 0 : i, d.rows == 1 ? i : 0));
-  }
+  camera.distortion = d.values;  // a row or a column: row-major order is the vector order
   return camera;
 }
 
-void WriteCamera(cv::FileStorage& fs, const char* key, const CameraIntrinsics& camera) {
-  fs << key << "{";
-  fs << "K" << ToMat(camera.K);
-  fs << "distortion" << "[:";
-  for (double k : camera.distortion) fs << k;
-  fs << "]";
-  fs << "}";
+// --- Writing: the layout cv::FileStorage writes (so OpenCV tools still read the files), with
+// shortest round-trip numbers and quoted names, so that every valid calibration reads back equal.
+
+std::string NumberText(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+// Double-quoted unless the name is a plain word that no YAML reader takes for a number, bool or
+// null; Validate allows only printable ASCII, so \" and \\ are the only escapes needed.
+std::string NameText(const std::string& name) {
+  static const std::set<std::string> kSpecial = {"null", "Null", "NULL", "true", "True", "TRUE",
+                                                 "false", "False", "FALSE", "yes", "Yes", "YES",
+                                                 "no", "No", "NO", "on", "On", "ON", "off",
+                                                 "Off", "OFF", "y", "Y", "n", "N"};
+  bool plain = !name.empty() && kSpecial.count(name) == 0 &&
+               ((name[0] >= 'a' && name[0] <= 'z') || (name[0] >= 'A' && name[0] <= 'Z') ||
+                name[0] == '_');
+  for (char c : name) {
+    plain = plain && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                      (c >= '0' && c <= '9') || c == '_' || c == '-');
+  }
+  if (plain) return name;
+  std::string quoted = "\"";
+  for (char c : name) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+std::string NumberList(const double* values, std::size_t count) {
+  if (count == 0) return "[]";
+  std::string text = "[ ";
+  for (std::size_t i = 0; i < count; ++i) text += (i ? ", " : "") + NumberText(values[i]);
+  return text + " ]";
+}
+
+template <typename Derived>
+void WriteMatrix(std::ostream& out, const std::string& indent, const char* key,
+                 const Eigen::MatrixBase<Derived>& m) {
+  std::vector<double> row_major;
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) row_major.push_back(m(r, c));
+  }
+  out << indent << key << ": !!opencv-matrix\n"
+      << indent << "   rows: " << m.rows() << "\n"
+      << indent << "   cols: " << m.cols() << "\n"
+      << indent << "   dt: d\n"
+      << indent << "   data: " << NumberList(row_major.data(), row_major.size()) << "\n";
+}
+
+void WriteCamera(std::ostream& out, const char* key, const CameraIntrinsics& camera) {
+  out << "      " << key << ":\n";
+  WriteMatrix(out, "         ", "K", camera.K);
+  out << "         distortion: "
+      << NumberList(camera.distortion.data(), camera.distortion.size()) << "\n";
 }
 
 void ValidateCamera(const CameraIntrinsics& camera, int width, int height,
@@ -216,25 +393,26 @@ bool FileExists(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-Calibration Parse(cv::FileStorage& fs, const std::string& origin) {
-  const cv::FileNode rigs = fs["rigs"];
-  if (rigs.isNone()) FieldError(origin, "rigs", "missing");
-  if (!rigs.isSeq()) FieldError(origin, "rigs", "expected a sequence, got " + NodeKind(rigs));
+Calibration Parse(const YAML::Node& root, const std::string& origin) {
+  if (!root.IsMap()) FieldError(origin, "document", "expected a map with 'rigs', got " + NodeKind(root));
+  const YAML::Node rigs = Child(root, "rigs");
+  if (!rigs.IsDefined()) FieldError(origin, "rigs", "missing");
+  if (!rigs.IsSequence()) FieldError(origin, "rigs", "expected a sequence, got " + NodeKind(rigs));
   Calibration calibration;
   int index = 0;
   for (const auto& node : rigs) {
     const std::string f = "rigs[" + std::to_string(index++) + "]";
-    if (!node.isMap()) FieldError(origin, f, "expected a map, got " + NodeKind(node));
+    if (!node.IsMap()) FieldError(origin, f, "expected a map, got " + NodeKind(node));
     RigCalibration rig;
     rig.rig_id = ReadInt(node, "id", origin, f + ".id");
     rig.name = ReadString(node, "name", origin, f + ".name");
     rig.width_px = ReadInt(node, "image_width", origin, f + ".image_width");
     rig.height_px = ReadInt(node, "image_height", origin, f + ".image_height");
-    rig.left = ReadCamera(node["left"], origin, f + ".left");
-    rig.right = ReadCamera(node["right"], origin, f + ".right");
+    rig.left = ReadCamera(node, "left", origin, f + ".left");
+    rig.right = ReadCamera(node, "right", origin, f + ".right");
     CopyTo(ReadMatSized(node, "R", 3, 3, origin, f + ".R"), &rig.R);
     CopyTo(ReadMatSized(node, "T", 3, 1, origin, f + ".T"), &rig.T);
-    const cv::Mat pose = ReadMatSized(node, "T_vehicle_rig", 4, 4, origin, f + ".T_vehicle_rig");
+    const Matrix pose = ReadMatSized(node, "T_vehicle_rig", 4, 4, origin, f + ".T_vehicle_rig");
     Eigen::Matrix4d m;
     CopyTo(pose, &m);
     if (m(3, 0) != 0 || m(3, 1) != 0 || m(3, 2) != 0 || m(3, 3) != 1) {
@@ -249,14 +427,22 @@ Calibration Parse(cv::FileStorage& fs, const std::string& origin) {
   return calibration;
 }
 
-// FileNode accessors assert (cv::Exception) on nodes of a kind Parse does not expect (a document
-// whose root is not a map, found by fuzzing); name the origin instead.
-Calibration ParseOrFail(cv::FileStorage& fs, const std::string& origin) {
-  try {
-    return Parse(fs, origin);
-  } catch (const cv::Exception& e) {
-    Fail(origin + ": malformed calibration: " + e.err);
+Calibration ParseText(std::string text, const std::string& origin) {
+  if (text.size() > kMaxCalibrationBytes) {
+    Fail(origin + ": calibration text is " + std::to_string(text.size()) + " bytes, over the " +
+         std::to_string(kMaxCalibrationBytes) + " any calibration needs");
   }
+  // OpenCV's "%YAML:1.0" header is not YAML's "%YAML 1.0" directive: read it as a comment, so the
+  // document parses the same with or without it (and line numbers in errors stay right).
+  if (text.compare(0, 6, "%YAML:") == 0) text[0] = '#';
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {  // DeepRecursion (nesting > 2000) is one too
+    Fail(origin + ": not a valid YAML calibration: line " + std::to_string(e.mark.line + 1) +
+         ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  return Parse(root, origin);
 }
 
 }  // namespace
@@ -280,6 +466,16 @@ void Calibration::Validate(const std::string& origin) const {
       FieldError(origin, f + ".id", "duplicate rig id " + std::to_string(rig.rig_id));
     }
     if (rig.name.empty()) FieldError(origin, f + ".name", "empty");
+    for (std::size_t c = 0; c < rig.name.size(); ++c) {
+      // Names label rigs in logs and UIs; printable ASCII also keeps the YAML quoting simple.
+      const auto byte = static_cast<unsigned char>(rig.name[c]);
+      if (byte < 0x20 || byte > 0x7e) {
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "0x%02x", byte);
+        FieldError(origin, f + ".name",
+                   "byte " + std::to_string(c) + " is " + hex + "; names are printable ASCII");
+      }
+    }
     if (rig.width_px <= 0) {
       FieldError(origin, f + ".image_width", "width = " + std::to_string(rig.width_px) + " must be > 0");
     }
@@ -304,51 +500,31 @@ void Calibration::Validate(const std::string& origin) const {
 
 Calibration Calibration::Load(const std::string& path) {
   if (!FileExists(path)) Fail(path + ": calibration file not found");
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) Fail(path + ": cannot open calibration file");
-  } catch (const cv::Exception& e) {
-    Fail(path + ": not a valid YAML calibration file: " + e.err);
-  } catch (const std::exception& e) {  // OpenCV's parser also throws std::length_error
-    Fail(path + ": not a valid YAML calibration file: " + e.what());
-  }
-  return ParseOrFail(fs, path);
+  return ParseText(ReadWholeFile(path, path + ": cannot open calibration file"), path);
 }
 
 Calibration Calibration::FromYaml(const std::string& yaml_text, const std::string& origin) {
   if (yaml_text.empty()) Fail(origin + ": empty calibration text");
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(yaml_text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
-      Fail(origin + ": cannot parse calibration text");
-    }
-  } catch (const cv::Exception& e) {
-    Fail(origin + ": not a valid YAML calibration: " + e.err);
-  } catch (const std::exception& e) {  // OpenCV's parser also throws std::length_error
-    Fail(origin + ": not a valid YAML calibration: " + e.what());
-  }
-  return ParseOrFail(fs, origin);
+  return ParseText(yaml_text, origin);
 }
 
 std::string Calibration::ToYaml() const {
-  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY |
-                                 cv::FileStorage::FORMAT_YAML);
-  fs << "rigs" << "[";
+  std::ostringstream out;
+  out.imbue(std::locale::classic());  // no digit grouping from a global locale in integers
+  out << "%YAML:1.0\n---\nrigs:\n";
   for (const auto& rig : rigs) {
-    fs << "{";
-    fs << "id" << rig.rig_id;
-    fs << "name" << rig.name;
-    fs << "image_width" << rig.width_px;
-    fs << "image_height" << rig.height_px;
-    WriteCamera(fs, "left", rig.left);
-    WriteCamera(fs, "right", rig.right);
-    fs << "R" << ToMat(rig.R);
-    fs << "T" << ToMat(rig.T);
-    fs << "T_vehicle_rig" << ToMat(rig.T_vehicle_rig.matrix());
-    fs << "}";
+    out << "   -\n"
+        << "      id: " << rig.rig_id << "\n"
+        << "      name: " << NameText(rig.name) << "\n"
+        << "      image_width: " << rig.width_px << "\n"
+        << "      image_height: " << rig.height_px << "\n";
+    WriteCamera(out, "left", rig.left);
+    WriteCamera(out, "right", rig.right);
+    WriteMatrix(out, "      ", "R", rig.R);
+    WriteMatrix(out, "      ", "T", rig.T);
+    WriteMatrix(out, "      ", "T_vehicle_rig", rig.T_vehicle_rig.matrix());
   }
-  fs << "]";
-  return fs.releaseAndGetString();
+  return out.str();
 }
 
 void Calibration::Save(const std::string& path) const {

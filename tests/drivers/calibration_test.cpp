@@ -1,12 +1,16 @@
 #include "romo/drivers/calibration.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/recording.hpp"
 #include "test_support.hpp"
 
 namespace romo::drivers {
@@ -233,6 +237,174 @@ TEST(CalibrationTest, MissingAndGarbledFilesGiveClearErrors) {
 TEST(CalibrationTest, UnknownRigIdThrows) {
   const Calibration cal = Calibration::Load(SampleCalibrationPath());
   EXPECT_THROW(cal.rig(6), romo::Error);
+}
+
+
+// Bit-for-bit: numbers are written in shortest round-trip form and read back exactly.
+void ExpectSameCalibration(const Calibration& a, const Calibration& b) {
+  ASSERT_EQ(a.rigs.size(), b.rigs.size());
+  for (std::size_t i = 0; i < a.rigs.size(); ++i) {
+    SCOPED_TRACE("rig " + std::to_string(i));
+    const RigCalibration& x = a.rigs[i];
+    const RigCalibration& y = b.rigs[i];
+    EXPECT_EQ(x.rig_id, y.rig_id);
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.width_px, y.width_px);
+    EXPECT_EQ(x.height_px, y.height_px);
+    EXPECT_EQ(x.left.K, y.left.K);
+    EXPECT_EQ(x.right.K, y.right.K);
+    EXPECT_EQ(x.left.distortion, y.left.distortion);
+    EXPECT_EQ(x.right.distortion, y.right.distortion);
+    EXPECT_EQ(x.R, y.R);
+    EXPECT_EQ(x.T, y.T);
+    EXPECT_EQ(x.T_vehicle_rig.matrix(), y.T_vehicle_rig.matrix());
+  }
+}
+
+Calibration SaveAndLoad(const Calibration& cal) {
+  test::ScratchDir dir;
+  cal.Save(dir / "saved.yaml");
+  return Calibration::Load(dir / "saved.yaml");
+}
+
+TEST(CalibrationTest, SampleLoadSaveLoadIsBitExact) {
+  const Calibration cal = Calibration::Load(SampleCalibrationPath());
+  ASSERT_EQ(cal.rigs.size(), 6u);
+  // Spot values as the file spells them (17 digits), compared exactly.
+  EXPECT_EQ(cal.rigs[0].T_vehicle_rig(0, 1), -2.5881904510252074e-01);
+  EXPECT_EQ(cal.rigs[0].T_vehicle_rig(1, 0), -1.0);
+  EXPECT_EQ(cal.rigs[0].left.distortion[1], 4.0000000000000001e-03);
+  EXPECT_EQ(cal.rigs[5].name, "right_front");
+  ExpectSameCalibration(cal, SaveAndLoad(cal));
+  ExpectSameCalibration(cal, Calibration::FromYaml(cal.ToYaml(), "memory"));
+}
+
+TEST(CalibrationTest, ReadsWhatOpenCvReadsFromTheSample) {
+  // The reader is not cv::FileStorage (it hangs on some inputs); on the shipped file both must
+  // give the same numbers.
+  const std::string path = SampleCalibrationPath();
+  const Calibration cal = Calibration::Load(path);
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  ASSERT_TRUE(fs.isOpened());
+  int index = 0;
+  for (const auto& node : fs["rigs"]) {
+    const RigCalibration& rig = cal.rigs[index++];
+    EXPECT_EQ(static_cast<int>(node["id"]), rig.rig_id);
+    EXPECT_EQ(static_cast<std::string>(node["name"]), rig.name);
+    cv::Mat K, R, T, pose;
+    node["left"]["K"] >> K;
+    node["R"] >> R;
+    node["T"] >> T;
+    node["T_vehicle_rig"] >> pose;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(K.at<double>(r, c), rig.left.K(r, c));
+        EXPECT_EQ(R.at<double>(r, c), rig.R(r, c));
+      }
+      EXPECT_EQ(T.at<double>(r, 0), rig.T(r));
+    }
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(pose.at<double>(r, c), rig.T_vehicle_rig(r, c));
+    }
+    std::vector<double> distortion;
+    node["right"]["distortion"] >> distortion;
+    EXPECT_EQ(distortion, rig.right.distortion);
+  }
+  EXPECT_EQ(index, 6);
+}
+
+TEST(CalibrationTest, OpenCvReadsWhatSaveWrites) {
+  // Saved files keep the FileStorage layout, so OpenCV tools still read them.
+  Calibration cal = Calibration::Load(SampleCalibrationPath());
+  cal.rigs[1].left.distortion = {0.1, -0.01, 0.001, 0.002};
+  cv::FileStorage fs(cal.ToYaml(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  ASSERT_TRUE(fs.isOpened());
+  const cv::FileNode rig = fs["rigs"][1];
+  EXPECT_EQ(static_cast<std::string>(rig["name"]), "left_front");
+  cv::Mat pose;
+  rig["T_vehicle_rig"] >> pose;
+  ASSERT_EQ(pose.rows, 4);
+  ASSERT_EQ(pose.cols, 4);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(pose.at<double>(r, c), cal.rigs[1].T_vehicle_rig(r, c));
+  }
+  std::vector<double> distortion;
+  rig["left"]["distortion"] >> distortion;
+  EXPECT_EQ(distortion, cal.rigs[1].left.distortion);
+}
+
+TEST(CalibrationTest, CalibrationsInRecordingsLoadSaveLoadBitExact) {
+  // Recordings carry the calibration as YAML text written by earlier builds (the fuzz seeds are
+  // real recordings of `romo sim`).
+  int with_calibration = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(test::SourcePath("fuzz/corpus/recording"))) {
+    SCOPED_TRACE(entry.path().string());
+    LogReader reader(entry.path().string());
+    reader.Next();
+    if (reader.calibration() == nullptr) continue;
+    ++with_calibration;
+    ExpectSameCalibration(*reader.calibration(), SaveAndLoad(*reader.calibration()));
+  }
+  EXPECT_GE(with_calibration, 3);
+}
+
+TEST(CalibrationTest, OddNamesRoundTrip) {
+  Calibration cal = Calibration::FromYaml(OneRigYaml({}), "hand.yaml");
+  for (const std::string name : {"null", "12", " padded ", "a: b", "quote\" and \\ back", "#x",
+                                 "'single'", "-", "true"}) {
+    SCOPED_TRACE(name);
+    cal.rigs[0].name = name;
+    EXPECT_EQ(SaveAndLoad(cal).rigs[0].name, name);
+  }
+}
+
+TEST(CalibrationTest, NonPrintableNameIsRejected) {
+  Calibration cal = Calibration::FromYaml(OneRigYaml({}), "hand.yaml");
+  cal.rigs[0].name = "fr\x01nt";
+  EXPECT_EQ(test::ErrorOf([&] { cal.Validate("cal.yaml"); }),
+            "cal.yaml: rigs[0].name: byte 2 is 0x01; names are printable ASCII");
+}
+
+TEST(CalibrationTest, OpenCvSpellingsAreTypedAsOpenCvTypesThem) {
+  // OpenCV writes NaN as .Nan; a quoted number is text; dt: f stores floats.
+  EXPECT_NE(YamlError({{"left", "{ K: [400, 0, 390.5, 0, 400, 290.5, 0, 0, .Nan], distortion: [] }"}})
+                .find("hand.yaml: rigs[0].left.K: element (2,2) = nan is not finite"),
+            std::string::npos);
+  EXPECT_EQ(YamlError({{"id", "\"0\""}}),
+            "hand.yaml: rigs[0].id: expected an integer, got the text '0'");
+  EXPECT_EQ(YamlError({{"name", "7"}}), "hand.yaml: rigs[0].name: expected text, got an integer");
+  EXPECT_EQ(YamlError({{"T", "!!opencv-matrix { rows: 3, cols: 1, dt: d, data: [ -0.25, 0 ] }"}}),
+            "hand.yaml: rigs[0].T: opencv-matrix rows x cols = 3x1 does not match its 2 numbers");
+  EXPECT_EQ(YamlError({{"T", "!!opencv-matrix { rows: 3, cols: 1, dt: 3d, data: [ -0.25, 0, 0 ] }"}}),
+            "hand.yaml: rigs[0].T.dt: expected one of u, c, w, s, i, f, d, got the text '3d'");
+  const Calibration cal = Calibration::FromYaml(
+      OneRigYaml({{"T", "!!opencv-matrix { rows: 3, cols: 1, dt: f, data: [ -0.1, 0, 0 ] }"}}),
+      "hand.yaml");
+  EXPECT_EQ(cal.rigs[0].T.x(), static_cast<double>(-0.1f));
+}
+
+TEST(CalibrationTest, DocumentThatHungOpenCvFailsFastNamingTheLine) {
+  // fuzz/regressions/calibration_yaml/opencv_4.6_yaml_parser_hung: OpenCV 4.6's FileStorage
+  // spun on it for > 90 s.
+  const std::string text =
+      "%YAML:1.000000000000000e+00, 0., 0., 00000000000e+00, 0., 0., 000000000   -\n"
+      "      id: 2\n  00   -\n      id: 2\n      na: #39\n [ -3 ";
+  ASSERT_EQ(text.size(), 129u);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string error = test::ErrorOf([&] { Calibration::FromYaml(text, "ROMO_CALIBRATION"); });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(error, "ROMO_CALIBRATION: not a valid YAML calibration: line 4, column 9: illegal map value");
+  constexpr double kMaxParseS = 1.0;  // it takes microseconds; 1 s allows a loaded CI machine
+  EXPECT_LT(seconds, kMaxParseS);
+}
+
+TEST(CalibrationTest, OversizedTextIsRefusedBeforeParsing) {
+  const std::string text = "%YAML:1.0\n---\nrigs: [" + std::string(2 << 20, ' ') + "]\n";
+  EXPECT_EQ(test::ErrorOf([&] { Calibration::FromYaml(text, "big.yaml"); }),
+            "big.yaml: calibration text is " + std::to_string(text.size()) +
+                " bytes, over the 1048576 any calibration needs");
 }
 
 }  // namespace

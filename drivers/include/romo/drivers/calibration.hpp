@@ -1,6 +1,6 @@
 #pragma once
 /// Stereo rig calibration: intrinsics, distortion, stereo extrinsics and the rig's pose on the
-/// vehicle, stored as OpenCV FileStorage YAML.
+/// vehicle, stored as OpenCV FileStorage-style YAML (read with yaml-cpp; OpenCV can read the files).
 #include <string>
 #include <vector>
 
@@ -37,12 +37,14 @@ struct Calibration {
   /// The rig with @p rig_id; @throws romo::Error when there is none.
   const RigCalibration& rig(int rig_id) const;
 
-  /// Reads and validates a calibration file.
+  /// Reads and validates a calibration file (at most 1 MiB).
   /// @throws romo::Error naming file, field and value for anything missing or implausible.
   static Calibration Load(const std::string& path);
   /// Same from YAML text (as carried in recordings); @p origin names it in errors.
   static Calibration FromYaml(const std::string& yaml_text, const std::string& origin);
+  /// Validates, then writes ToYaml(); Load of the file gives back identical values.
   void Save(const std::string& path) const;
+  /// The %YAML:1.0 / !!opencv-matrix layout, numbers in shortest round-trip form.
   std::string ToYaml() const;
   /// @throws romo::Error naming @p origin, field and value.
   void Validate(const std::string& origin) const;
