@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/lcm_walker.hpp"
 #include "romo_lcm/obstacle_list_t.hpp"
 #include "romo_lcm/parking_slots_t.hpp"
 #include "romo_lcm/perception_status_t.hpp"
@@ -30,55 +31,11 @@ void SetWhy(std::string* why, const std::string& text) {
 }
 
 // LCM's generated decoders size their arrays from the counts in the message before checking the
-// buffer, so a corrupt count could ask for gigabytes. Walk the encoding first: every count must
-// fit the bytes that are left.
-class Walker {
- public:
-  Walker(const void* data, std::size_t size) : b_(static_cast<const std::uint8_t*>(data)), n_(size) {}
-  bool Skip(std::size_t bytes) {
-    if (!ok_ || bytes > n_ - pos_) return ok_ = false;
-    pos_ += bytes;
-    return true;
-  }
-  /// Reads a count; false (and marks the walk failed) when negative or when count * each bytes
-  /// cannot fit the rest of the message.
-  bool Count(std::size_t each, std::int32_t* out, const char* field) {
-    if (!ok_ || 4 > n_ - pos_) return ok_ = false;
-    const std::uint8_t* p = b_ + pos_;
-    const auto v = static_cast<std::int32_t>((std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
-                                             (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]});
-    pos_ += 4;
-    if (v < 0 || static_cast<std::size_t>(v) * each > n_ - pos_) {
-      bad_field_ = field;
-      bad_value_ = v;
-      return ok_ = false;
-    }
-    *out = v;
-    return true;
-  }
-  bool String(const char* field) {
-    std::int32_t len = 0;
-    return Count(1, &len, field) && Skip(static_cast<std::size_t>(len));
-  }
-  bool ok() const { return ok_; }
-  std::string Reason(const char* type) const {
-    if (bad_field_ != nullptr) {
-      return std::string(type) + "." + bad_field_ + " = " + std::to_string(bad_value_) +
-             " does not fit a " + std::to_string(n_) + "-byte message";
-    }
-    return std::string(type) + ": truncated (" + std::to_string(n_) + " bytes)";
-  }
+// buffer, so a corrupt count could ask for gigabytes: each message is walked first with the
+// shared bounds checks (drivers::LcmWalker, as the sensor and prediction decoders do).
+using drivers::LcmWalker;
 
- private:
-  const std::uint8_t* b_;
-  std::size_t n_;
-  std::size_t pos_ = 0;
-  bool ok_ = true;
-  const char* bad_field_ = nullptr;
-  std::int32_t bad_value_ = 0;
-};
-
-bool WalkObstacleList(Walker& w) {
+bool WalkObstacleList(LcmWalker& w) {
   std::int32_t n = 0;
   if (!(w.Skip(8 + 16) && w.Count(4 + 5 + 4 + 8 * 13 + 4, &n, "num_obstacles"))) return false;
   for (std::int32_t i = 0; i < n; ++i) {
@@ -87,7 +44,7 @@ bool WalkObstacleList(Walker& w) {
   return true;
 }
 
-bool WalkParkingSlots(Walker& w) {
+bool WalkParkingSlots(LcmWalker& w) {
   std::int32_t n = 0;
   if (!(w.Skip(8 + 16 + 1 + 24) && w.Count(150, &n, "num_slots"))) return false;
   for (std::int32_t i = 0; i < n; ++i) {
@@ -101,7 +58,7 @@ bool WalkParkingSlots(Walker& w) {
   return true;
 }
 
-bool WalkPerceptionStatus(Walker& w) {
+bool WalkPerceptionStatus(LcmWalker& w) {
   std::int32_t n = 0;
   if (!(w.Skip(8 + 16) && w.Count(29, &n, "num_rigs") && w.Skip(29 * static_cast<std::size_t>(n)) &&
         w.Count(9, &n, "num_stages"))) {
@@ -117,20 +74,20 @@ bool WalkPerceptionStatus(Walker& w) {
   return true;
 }
 
-bool WalkRigCloud(Walker& w) {
+bool WalkRigCloud(LcmWalker& w) {
   std::int32_t points = 0, coords = 0;
   return w.Skip(8 + 16 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
          w.Skip(2 * static_cast<std::size_t>(coords)) && w.Skip(3 * static_cast<std::size_t>(points)) &&
          w.Skip(8 + 1 + 8 * 9);
 }
 
-bool Walk(const void* data, std::size_t size, bool (*walk)(Walker&), const char* type,
+bool Walk(const void* data, std::size_t size, bool (*walk)(LcmWalker&), const char* type,
           std::string* why) {
   if (data == nullptr) {
     SetWhy(why, std::string(type) + ": no data");
     return false;
   }
-  Walker w(data, size);
+  LcmWalker w(data, size);
   if (!walk(w)) {
     SetWhy(why, w.Reason(type));
     return false;
