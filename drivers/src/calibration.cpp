@@ -122,12 +122,14 @@ std::string NodeKind(const YAML::Node& node) {
   return "the text '" + node.Scalar() + "'";
 }
 
-// A key of a map node; missing for anything else (yaml-cpp's const operator[] throws on
-// scalars, and a non-const one would insert).
+// A key of a map node; an undefined node for anything else. yaml-cpp's const operator[] throws on
+// scalars (a non-const one would insert), and for a missing key returns an invalid node whose
+// Type() throws InvalidNode (found by fuzzing): normalise both.
 YAML::Node Child(const YAML::Node& parent, const char* key) {
-  if (!parent.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
+  if (!parent.IsDefined() || !parent.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
   const YAML::Node& const_parent = parent;
-  return const_parent[key];
+  const YAML::Node found = const_parent[key];
+  return found.IsDefined() ? found : YAML::Node(YAML::NodeType::Undefined);
 }
 
 int ReadInt(const YAML::Node& parent, const char* key, const std::string& origin,

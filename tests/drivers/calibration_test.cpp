@@ -376,6 +376,9 @@ TEST(CalibrationTest, OpenCvSpellingsAreTypedAsOpenCvTypesThem) {
   EXPECT_EQ(YamlError({{"name", "7"}}), "hand.yaml: rigs[0].name: expected text, got an integer");
   EXPECT_EQ(YamlError({{"T", "!!opencv-matrix { rows: 3, cols: 1, dt: d, data: [ -0.25, 0 ] }"}}),
             "hand.yaml: rigs[0].T: opencv-matrix rows x cols = 3x1 does not match its 2 numbers");
+  // Found by fuzzing: a missing key threw yaml-cpp's InvalidNode instead of naming the field.
+  EXPECT_EQ(YamlError({{"T", "!!opencv-matrix { rows: 3, dt: d, data: [ -0.25, 0, 0 ] }"}}),
+            "hand.yaml: rigs[0].T.cols: expected a count, got missing");
   EXPECT_EQ(YamlError({{"T", "!!opencv-matrix { rows: 3, cols: 1, dt: 3d, data: [ -0.25, 0, 0 ] }"}}),
             "hand.yaml: rigs[0].T.dt: expected one of u, c, w, s, i, f, d, got the text '3d'");
   const Calibration cal = Calibration::FromYaml(
