@@ -169,6 +169,14 @@ TEST(MessagesTest, MalformedMessagesAreRejectedWithAReason) {
   cloud_bytes[32] = 0x7f;
   EXPECT_FALSE(DecodeRigCloud(cloud_bytes.data(), cloud_bytes.size(), &why));
   EXPECT_NE(why.find("num_points"), std::string::npos) << why;
+  // A string length of 0 (LCM always counts the NUL): the generated decoder would assign
+  // size_t(-1) bytes; the shared walk rejects it first. Offset 32: hash, stamp, sequence,
+  // num_obstacles, track_id.
+  auto empty_name = Encode(SampleObstacles());
+  for (int i = 32; i < 36; ++i) empty_name[i] = 0;
+  EXPECT_FALSE(DecodeObstacleList(empty_name.data(), empty_name.size(), &why));
+  EXPECT_EQ(why, "obstacle_list_t.class_name = 0 does not fit a " +
+                     std::to_string(empty_name.size()) + "-byte message");
   // Trailing bytes.
   bytes.push_back(0);
   EXPECT_FALSE(DecodeObstacleList(bytes.data(), bytes.size(), &why));
