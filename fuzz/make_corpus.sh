@@ -37,7 +37,7 @@ PY
 "$romo" record --source "rgbd://$work/rgbd" --png --out "$work/rgbd_png.lcmlog" >/dev/null
 
 rm -rf "$out"
-mkdir -p "$out"/{lcm_sensors,lcm_planning,lcm_ground_truth,lcm_predictions,recording,calibration_yaml,rig_yaml,atlas_yaml,pcd,eth_ucy,sim_uri}
+mkdir -p "$out"/{lcm_sensors,lcm_planning,lcm_ground_truth,lcm_predictions,recording,calibration_yaml,rig_yaml,atlas_yaml,object_functions_yaml,pcd,eth_ucy,sim_uri}
 
 # Single messages out of the logs: the first event of each (log, channel) listed.
 python3 - "$work" "$out" <<'PY'
@@ -87,6 +87,7 @@ PY
 cp config/calibration/romo_sample.yaml "$out/calibration_yaml/"
 cp config/rigs/*.yaml "$out/rig_yaml/"
 cp config/atlas.yaml "$out/atlas_yaml/"
+cp config/object_functions.yaml "$out/object_functions_yaml/"
 
 # PCD: the first 16 points of PCL's lamppost.pcd as ascii, binary and binary_compressed (LZF
 # literal runs, field-major as PCL stores it), plus a FLOAT64/intensity variant.

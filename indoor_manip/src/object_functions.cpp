@@ -98,7 +98,9 @@ ObjectFunctionAtlas ObjectFunctionAtlas::Parse(const std::string& yaml_text, con
       Bad(source, obj["interaction_plane"], field + ".interaction_plane", plane, "need 'vertical' or 'table'");
     }
     const YAML::Node fns = obj["functions"];
-    if (!fns.IsSequence() || fns.size() == 0) {
+    // IsDefined first: a missing key of a const map is an invalid node whose IsSequence() throws
+    // YAML::InvalidNode (found by fuzz_object_functions_yaml).
+    if (!fns.IsDefined() || !fns.IsSequence() || fns.size() == 0) {
       Bad(source, fns.IsDefined() ? fns : obj, field + ".functions", Text(fns), "need a non-empty list");
     }
     std::set<std::string> labels;

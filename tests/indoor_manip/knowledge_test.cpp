@@ -89,6 +89,14 @@ TEST(ObjectFunctionsTest, BadYamlNamesFileLineFieldAndValue) {
   EXPECT_NE(e.find("objects.hammer.functions[0].patern"), std::string::npos) << e;
   EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
 
+  // No functions key at all: named, not yaml-cpp's InvalidNode (found by fuzzing).
+  e = test::ErrorOf([] {
+    ObjectFunctionAtlas::Parse(WithHammer("  hammer:\n    interaction_plane: table\n"), "a.yaml");
+  });
+  EXPECT_NE(e.find("field 'objects.hammer.functions' = '<missing>': need a non-empty list"),
+            std::string::npos)
+      << e;
+
   // Removing pulling leaves an action the plugin reports without any object to explain it.
   e = test::ErrorOf([] {
     ObjectFunctionAtlas::Parse(WithHammer("  hammer:\n    interaction_plane: table\n    functions:\n"
