@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,7 +43,7 @@ struct Options {
   std::vector<std::string> stamp_jumps;  // "AT_S:OFFSET_S"
 };
 
-// A fault scheduled at a time after the cameras start serving.
+// A fault scheduled at a time after the first frame is served.
 struct Fault {
   double at_s = 0.0;
   std::string what;
@@ -208,17 +209,26 @@ void Serve(const Options& options) {
   const std::uint64_t total = options.loop ? 0 : stamps.size();
   Progress progress("gige-serve", total);
   const auto start = std::chrono::steady_clock::now();
+  // Faults are timed from the first frame a client receives, not from start-up: a client that
+  // takes seconds to open the cameras (discovery on a loaded machine) still sees each fault at
+  // the same point of its acquisition.
+  std::optional<std::chrono::steady_clock::time_point> acquiring_since;
   while (!g_stop) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     const auto served = emulator.frames_served();
     const std::uint64_t least = *std::min_element(served.begin(), served.end());
+    const std::uint64_t most = *std::max_element(served.begin(), served.end());
     progress.Update(std::min<std::uint64_t>(least, total ? total : least),
                     std::to_string(served.size()) + " cameras");
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    while (!faults.empty() && elapsed >= faults.front().at_s) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!acquiring_since && most > 0) acquiring_since = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    const double acquiring_s =
+        acquiring_since ? std::chrono::duration<double>(now - *acquiring_since).count() : -1.0;
+    while (!faults.empty() && acquiring_s >= faults.front().at_s) {
       faults.front().apply(emulator);
       // On stdout, flushed: tests and operators line faults up with what the client reports.
-      std::printf("fault at %.2f s: %s\n", elapsed, faults.front().what.c_str());
+      std::printf("fault at %.2f s of acquisition: %s\n", acquiring_s, faults.front().what.c_str());
       std::fflush(stdout);
       faults.erase(faults.begin());
     }
@@ -261,11 +271,13 @@ void Register(CLI::App& root) {
                       "Fault injection: every camera drops this percentage of its GVSP packets")
       ->check(CLI::Range(0.0, 100.0));
   command->add_option("--stall", options->stalls,
-                      "Fault injection: SERIAL:AT_S:FOR_S stalls a camera AT_S seconds after start "
-                      "for FOR_S seconds (it stays discoverable but sends no frames); repeatable");
+                      "Fault injection: SERIAL:AT_S:FOR_S stalls a camera AT_S seconds after the first "
+                      "frame is served, for FOR_S seconds (it stays discoverable but sends no "
+                      "frames); repeatable");
   command->add_option("--stamp-jump", options->stamp_jumps,
                       "Fault injection: AT_S:OFFSET_S shifts every camera's device timestamps by "
-                      "OFFSET_S (negative: back in time) from AT_S seconds after start; repeatable");
+                      "OFFSET_S (negative: back in time) from AT_S seconds after the first frame is "
+                      "served; repeatable");
   command->callback([options] { Serve(*options); });
 }
 

@@ -1,14 +1,18 @@
 // `romo record --source URI --out FILE.lcmlog [--frames N] [--png] [--status-lcm-url URL]`: any
 // frame source to an LCM log, optionally publishing a perception status (camera losses, events,
-// write failures) after every frame set so faults show on the bus while recording.
+// write failures) after every frame set, and twice a second while a live source is silent, so
+// faults show on the bus while recording.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +21,7 @@
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
 #include "romo/drivers/frame_source.hpp"
+#include "romo/drivers/gige.hpp"
 #include "romo/drivers/recording.hpp"
 #include "romo/planning_iface/lcm_bus.hpp"
 #include "romo/planning_iface/messages.hpp"
@@ -55,16 +60,24 @@ void PrintSourceEvents(const drivers::FrameSource& source) {
 // The recorder's perception status: per rig the frame sets it was in, frames_processed = sets
 // written, frames_dropped = camera frames that never reached the file (incomplete, unpaired,
 // dropped), events = source events and the recorder's own (stamps going back, write failures),
-// each published once.
+// each published once. Thread-safe: a heartbeat publishes while the source is silent.
 class StatusPublisher {
  public:
+  using Clock = std::chrono::steady_clock;
+
   explicit StatusPublisher(const std::string& url) {
     if (!url.empty()) bus_ = std::make_unique<planning_iface::LcmBus>(url);
   }
 
-  void AddEvent(const std::string& event) { own_events_.push_back(event); }
+  bool enabled() const { return bus_ != nullptr; }
+
+  void AddEvent(const std::string& event) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    own_events_.push_back(event);
+  }
 
   void CountSet(const drivers::FrameSet& frames) {
+    std::lock_guard<std::mutex> lock(mutex_);
     last_stamp_ns_ = frames.stamp_ns;
     last_sequence_ = static_cast<std::int64_t>(frames.sequence);
     present_.clear();
@@ -75,6 +88,20 @@ class StatusPublisher {
     ++sets_;
   }
 
+  void Publish(const drivers::FrameSource& source, double write_ms) {
+    if (!bus_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    PublishLocked(source, write_ms);
+  }
+
+  /// Publishes (no new set, same counters, new events) when nothing went out for @p quiet.
+  void PublishIfQuiet(const drivers::FrameSource& source, Clock::duration quiet) {
+    if (!bus_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (Clock::now() - last_publish_ >= quiet) PublishLocked(source, 0.0);
+  }
+
+ private:
   planning_iface::PerceptionStatus Build(const drivers::SourceStatus& source, double write_ms) {
     planning_iface::PerceptionStatus status;
     status.stamp_ns = last_stamp_ns_;
@@ -102,8 +129,8 @@ class StatusPublisher {
     return status;
   }
 
-  void Publish(const drivers::FrameSource& source, double write_ms) {
-    if (!bus_) return;
+  void PublishLocked(const drivers::FrameSource& source, double write_ms) {
+    last_publish_ = Clock::now();
     const auto status = Build(source.status(), write_ms);
     try {
       bus_->Publish(planning_iface::kPerceptionStatusChannel, planning_iface::Encode(status));
@@ -114,8 +141,9 @@ class StatusPublisher {
     }
   }
 
- private:
   std::unique_ptr<planning_iface::LcmBus> bus_;
+  std::mutex mutex_;
+  Clock::time_point last_publish_ = Clock::now();
   std::map<int, std::int64_t> rig_frames_;
   std::map<int, bool> present_;
   std::int64_t sets_ = 0;
@@ -124,6 +152,40 @@ class StatusPublisher {
   std::size_t source_events_published_ = 0;
   std::vector<std::string> own_events_;
   bool publish_failed_ = false;
+};
+
+// While the source is silent (a stalled camera holds Next() up to stall_timeout_s) the status
+// still goes out every kQuiet, so a stall shows while it lasts, not only once frames are back.
+// Only for the live GigE source: its status() may be called while Next() blocks.
+class StatusHeartbeat {
+ public:
+  static constexpr std::chrono::milliseconds kQuiet{500};
+
+  StatusHeartbeat(StatusPublisher* status, const drivers::FrameSource& source) {
+    if (!status->enabled() || dynamic_cast<const drivers::GigeSource*>(&source) == nullptr) return;
+    thread_ = std::thread([this, status, &source] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      while (!stop_) {
+        wake_.wait_for(lock, std::chrono::milliseconds(100));
+        if (!stop_) status->PublishIfQuiet(source, kQuiet);
+      }
+    });
+  }
+  ~StatusHeartbeat() { Stop(); }
+  void Stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::thread thread_;
 };
 
 void Record(const RecordOptions& options) {
@@ -139,6 +201,7 @@ void Record(const RecordOptions& options) {
   drivers::LogWriter writer(options.out,
                             options.png ? drivers::ImageEncoding::kPng : drivers::ImageEncoding::kRaw);
 
+  StatusHeartbeat heartbeat(&status, *source);
   Progress progress("record", options.frames);
   std::uint64_t count = 0;
   bool calibration_written = false;
@@ -192,6 +255,7 @@ void Record(const RecordOptions& options) {
       write_failed = true;
     }
   }
+  heartbeat.Stop();
   progress.Finish(std::to_string(writer.bytes_written() / (1024 * 1024)) + " MB");
   writer.Close();
   std::signal(SIGINT, old_int);
@@ -227,7 +291,8 @@ void Register(CLI::App& root) {
   command->add_flag("--png", options->png, "Store images as lossless PNG instead of raw");
   command->add_option("--status-lcm-url", options->status_lcm_url,
                       "Publish a perception status (ROMO_PERCEPTION_STATUS: sets written, camera "
-                      "frames lost, events) on this LCM URL after every frame set");
+                      "frames lost, events) on this LCM URL after every frame set (gige://: also every "
+                      "0.5 s while no set comes)");
   command->callback([options] { Record(*options); });
 }
 

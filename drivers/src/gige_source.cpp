@@ -126,6 +126,7 @@ class GigeSource::Impl {
     GigeCameraDiagnostics diagnostics;
     bool have_frame_id = false;
     std::uint64_t last_frame_id = 0;
+    Clock::time_point last_frame_id_time;
     bool have_stamp = false;
     std::int64_t last_stamp_ns = 0;
     std::uint64_t stamp_jumps_back = 0;
@@ -409,10 +410,10 @@ class GigeSource::Impl {
       g_object_unref(handle);
       return text;
     }
+    // The last block id is kept: a camera reopened after a stall goes on counting, so the frames
+    // it sent while nobody received them are counted lost (Deliver tells a restart from a gap).
     camera->camera = handle;
     camera->stream = stream;
-    std::lock_guard<std::mutex> lock(mutex_);
-    camera->have_frame_id = false;  // a reopened camera may restart its block ids
     return "";
   }
 
@@ -478,17 +479,35 @@ class GigeSource::Impl {
         convert_error = e.what();
       }
     }
+    const auto now = Clock::now();
     std::lock_guard<std::mutex> lock(mutex_);
     CameraCounters& counters = camera->counters;
-    if (camera->have_frame_id) {
-      const std::uint64_t gap = FrameIdGap(camera->last_frame_id, frame_id);
-      counters.dropped += gap;
-      camera->diagnostics.frame_ids_spanned += gap + 1;
-    } else {
-      camera->diagnostics.frame_ids_spanned += 1;
+    std::uint64_t gap = 0;
+    // Block id 0 is never sent (GigE Vision): such a buffer never got a packet to say which frame
+    // it was, and must not become the reference for the next gap.
+    const bool have_id = frame_id != 0;
+    if (have_id && camera->have_frame_id) {
+      gap = FrameIdGap(camera->last_frame_id, frame_id);
+      // A camera restarted behind our back (power cycle, new process) starts its block ids
+      // anywhere: ids further ahead than it can have sent since the last one are no loss. The
+      // second of slack covers frames delivered late (Aravis frame retention, a starved thread).
+      const double possible = (Seconds(now - camera->last_frame_id_time) + 1.0) *
+                                  camera->rig->config.frame_rate_hz + 2.0;
+      if (static_cast<double>(gap) > possible) {
+        AddEvent("gige: " + camera->label + ": block id went from " +
+                 std::to_string(camera->last_frame_id) + " to " + std::to_string(frame_id) + " in " +
+                 Fixed(Seconds(now - camera->last_frame_id_time), 2) +
+                 " s, more than the camera can send: taken for a camera restart, not counted lost");
+        gap = 0;
+      }
     }
-    camera->have_frame_id = true;
-    camera->last_frame_id = frame_id;
+    counters.dropped += gap;
+    camera->diagnostics.frame_ids_spanned += gap + 1;
+    if (have_id) {
+      camera->have_frame_id = true;
+      camera->last_frame_id = frame_id;
+      camera->last_frame_id_time = now;
+    }
     if (frame) {
       // Device clocks only grow; one going back was reset (power cycle, PTP step). The frames are
       // kept (the pairer starts over), the jump is reported.

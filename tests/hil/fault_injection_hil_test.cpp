@@ -18,7 +18,6 @@
 #include "hil_support.hpp"
 #include "romo/drivers/gige.hpp"
 #include "romo/drivers/recording.hpp"
-#include "romo/planning_iface/lcm_bus.hpp"
 #include "romo/planning_iface/messages.hpp"
 #include "served_recording.hpp"
 #include "status_listener.hpp"
@@ -168,51 +167,111 @@ TEST(FaultInjectionHilTest, KilledCameraIsRecoveredAndTheRecoveryTimeMeasured) {
               outage_s, kDowntimeS, recovery_s, check.sets, largest_step * 1e-9 * 10.0 - 1.0, largest_step * 1e-9);
 }
 
-// TODO(reliability): the stall does not show as a gap in the recording yet (13 sets, largest step 0.1 s).
-TEST(FaultInjectionHilTest, DISABLED_StalledCameraStaysDiscoverableIsReportedAndRecovers) {
+// The stalled camera's own counters and the emulator's count of frames it did not send.
+struct StallCounts {
+  Counters left, right;
+  unsigned long long not_sent = 0;
+};
+
+TEST(FaultInjectionHilTest, StalledCameraStaysDiscoverableIsReportedAndRecovers) {
   ServedRig rig;
-  constexpr double kStallAtS = 3.0, kStallForS = 4.0;
+  // Timed from the recorder's first frame (gige-serve starts the fault clock there).
+  constexpr double kStallAtS = 2.0, kStallForS = 4.0, kPeriodS = 0.1;
   ASSERT_NO_FATAL_FAILURE(rig.Start("--stall romo-r0-r:" + std::to_string(kStallAtS) + ":" + std::to_string(kStallForS)));
-  const auto served_from = Clock::now();
   StatusListener listener(LcmUrl(7703));
   Background recorder(rig.Record(rig.dir / "stalled.lcmlog", 7703) + " >" + rig.dir / "record.out" + " 2>" +
                       rig.dir / "record.err");
+  // Reported while it lasts: the recorder's status goes out even when no set does.
+  ASSERT_TRUE(listener.WaitFor([&] { return listener.HasEvent("127.0.0.3", "camera stalled"); }, 30.0))
+      << test::ReadFile(rig.dir / "record.err") << test::ReadFile(rig.dir / "serve.out");
+  const auto stall_seen = Clock::now();
+  EXPECT_FALSE(listener.HasEvent("frames again after reconnect")) << "the stall was only reported after it ended";
   // Mid-stall the camera still answers discovery.
-  std::this_thread::sleep_for(std::chrono::duration<double>(kStallAtS + 1.0 - SecondsSince(served_from)));
   bool discoverable = false;
   for (const auto& device : drivers::DiscoverGigeCameras()) discoverable |= device.serial == "romo-r0-r";
   EXPECT_TRUE(discoverable);
   ASSERT_TRUE(listener.WaitFor([&] { return listener.HasEvent("frames again after reconnect"); }, 30.0))
       << test::ReadFile(rig.dir / "record.err") << test::ReadFile(rig.dir / "serve.out");
+  const double stall_seen_for_s = SecondsSince(stall_seen);
   const std::int64_t sets_at_recovery = listener.frames_processed();
   ASSERT_TRUE(listener.WaitFor([&] { return listener.frames_processed() >= sets_at_recovery + 10; }, 20.0));
   ASSERT_TRUE(recorder.running());
   const int status = recorder.Kill(SIGINT);
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::ReadFile(rig.dir / "record.err");
+  rig.server->Kill(SIGINT);  // it then says how many frames the stall kept from being sent
 
   const Check check = CheckRecorded(rig.dir / "stalled.lcmlog", rig.served);
   listener.WaitFor([&] { return listener.frames_processed() == check.sets; }, 3.0);
   EXPECT_EQ(check.sets, listener.frames_processed());
   EXPECT_TRUE(listener.HasEvent("127.0.0.3", "camera lost (no frame for"));
-  EXPECT_TRUE(listener.HasEvent("127.0.0.3", "camera stalled")) << "a camera that reopens but sends nothing";
   EXPECT_TRUE(listener.HasEvent("127.0.0.3", "gap"));
-  // The left camera went on alone during the stall: ~10 frames/s without a partner, counted.
-  const auto statuses = listener.statuses();
-  EXPECT_GE(statuses.back().frames_dropped, static_cast<std::int64_t>(0.75 * kStallForS * 10.0));
+  EXPECT_FALSE(listener.HasEvent("127.0.0.2", "camera lost")) << "the left camera went on";
+
+  StallCounts counts;
+  const std::string err = test::ReadFile(rig.dir / "record.err");
+  const std::vector<std::pair<std::string, Counters*>> cameras = {{"romo record: ip:127.0.0.2: ", &counts.left},
+                                                                   {"romo record: ip:127.0.0.3: ", &counts.right}};
+  for (const auto& [prefix, counters] : cameras) {
+    const std::size_t at = err.find(prefix);
+    ASSERT_NE(at, std::string::npos) << err;
+    ASSERT_EQ(std::sscanf(err.c_str() + at + prefix.size(),
+                          "%llu completed, %llu incomplete, %llu unpaired, %llu dropped, %llu reconnects",
+                          &counters->completed, &counters->incomplete, &counters->unpaired, &counters->dropped,
+                          &counters->reconnects),
+              5)
+        << err;
+  }
+  const std::string served_out = test::ReadFile(rig.dir / "serve.out");
+  const std::size_t at = served_out.find("camera 1: ");
+  ASSERT_NE(at, std::string::npos) << served_out;
+  ASSERT_EQ(std::sscanf(served_out.c_str() + at, "camera 1: %llu frames not sent", &counts.not_sent), 1);
+  // The emulator's own count: the stall's length in frames (its 20 ms fault loop may run late).
+  EXPECT_GE(counts.not_sent, static_cast<unsigned long long>(0.75 * kStallForS / kPeriodS));
+  EXPECT_LE(counts.not_sent, static_cast<unsigned long long>(1.5 * kStallForS / kPeriodS));
+  // The rig's stamps show the stall: its largest step spans the frames the recorder missed, which
+  // are the frames not sent (one either side of each edge may fall in or out) plus those sent
+  // while a reopen was under way (opening takes well under 1 s = 10 frames, even under load).
+  constexpr double kEdgeFrames = 3.0, kReopenFrames = 10.0;
   std::int64_t largest_step = 0;
   for (std::size_t i = 1; i < check.stamps_ns.size(); ++i) {
     largest_step = std::max(largest_step, check.stamps_ns[i] - check.stamps_ns[i - 1]);
   }
-  EXPECT_GE(largest_step * 1e-9, kStallForS - 0.15);
+  const double missed = largest_step * 1e-9 / kPeriodS - 1.0;
+  EXPECT_GE(missed, counts.not_sent - kEdgeFrames);
+  EXPECT_LE(missed, counts.not_sent + kReopenFrames);
+  // Counted on both sides, each about stall x rate: the stalled camera's block ids skip what it
+  // did not send, its partner's frames went unpaired. The tolerance covers ticks a starved camera
+  // thread skipped (no block id, but a stamp step) and a frame lost elsewhere in the run.
+  EXPECT_GE(counts.right.reconnects, 1u);
+  EXPECT_NEAR(static_cast<double>(counts.right.dropped), missed, kEdgeFrames) << err;
+  EXPECT_NEAR(static_cast<double>(counts.left.unpaired), missed, kEdgeFrames) << err;
+  // The status counts exactly what the counters say, both cameras together.
+  const auto statuses = listener.statuses();
+  const std::int64_t counted = static_cast<std::int64_t>(
+      counts.left.incomplete + counts.left.unpaired + counts.left.dropped + counts.right.incomplete +
+      counts.right.unpaired + counts.right.dropped);
+  EXPECT_EQ(statuses.back().frames_dropped, counted);
+  double gap_s = 0.0;  // the outage the source reports: last frame before to first after
+  for (const auto& event : listener.events()) {
+    const std::size_t g = event.find(", gap ");
+    if (event.find("frames again after reconnect") != std::string::npos && g != std::string::npos) {
+      std::sscanf(event.c_str() + g + 6, "%lf", &gap_s);
+    }
+  }
   PrintEvents(listener);
-  std::printf("FIGURE camera_stall %.1f s: %d sets delivered, %lld camera frames lost, largest stamp step %.2f s\n",
-              kStallForS, check.sets, static_cast<long long>(statuses.back().frames_dropped), largest_step * 1e-9);
+  std::printf("FIGURE camera_stall %.1f s: %d sets delivered; %llu frames not sent, %llu counted dropped on the "
+              "stalled camera, %llu unpaired on its partner, %lld camera frames lost in the status; largest stamp "
+              "step %.2f s; stall reported %.2f s before frames were back; outage %.2f s (recovery %.2f s after "
+              "the camera sent again)\n",
+              kStallForS, check.sets, counts.not_sent, counts.right.dropped, counts.left.unpaired,
+              static_cast<long long>(statuses.back().frames_dropped), largest_step * 1e-9, stall_seen_for_s, gap_s,
+              gap_s - (counts.not_sent + 1) * kPeriodS);
 }
 
-// TODO(reliability): the scheduled --stamp-jump did not reach the recording in the first run.
-TEST(FaultInjectionHilTest, DISABLED_TimestampsJumpingBackAreKeptAndReported) {
+TEST(FaultInjectionHilTest, TimestampsJumpingBackAreKeptAndReported) {
   ServedRig rig;
-  constexpr double kJumpAtS = 2.0, kJumpS = -5.0;
+  // Timed from the recorder's first frame: the jump lands about a third into the 45 sets.
+  constexpr double kJumpAtS = 1.5, kJumpS = -5.0, kPeriodS = 0.1;
   ASSERT_NO_FATAL_FAILURE(rig.Start("--stamp-jump " + std::to_string(kJumpAtS) + ":" + std::to_string(kJumpS)));
   StatusListener listener(LcmUrl(7704));
   constexpr int kSets = 45;
@@ -220,25 +279,46 @@ TEST(FaultInjectionHilTest, DISABLED_TimestampsJumpingBackAreKeptAndReported) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const Check check = CheckRecorded(rig.dir / "jump.lcmlog", rig.served);
   EXPECT_EQ(check.sets, kSets);
-  int back_steps = 0;
+  ASSERT_EQ(check.indices.size(), check.stamps_ns.size());
+  const int count = static_cast<int>(rig.served.frames[0].size());
+  int back_steps = 0, jump_at = -1, ticks_at_jump = 0;
   double back_s = 0.0;
   for (std::size_t i = 1; i < check.stamps_ns.size(); ++i) {
-    if (check.stamps_ns[i] < check.stamps_ns[i - 1]) {
+    // The images say how many frame periods passed (modulo the 10 served frames); the stamps must
+    // agree, across the jump too (-5 s is a whole number of loops): nothing reordered.
+    const int ticks = ((check.indices[i] - check.indices[i - 1]) % count + count) % count;
+    const std::int64_t step_ns = check.stamps_ns[i] - check.stamps_ns[i - 1];
+    const auto step_ticks = static_cast<std::int64_t>(std::llround(step_ns * 1e-9 / kPeriodS));
+    EXPECT_EQ(((step_ticks % count) + count) % count, ticks) << "set " << i;
+    EXPECT_NEAR(step_ns * 1e-9, step_ticks * kPeriodS, 1e-6) << "stamps are on the served grid";
+    if (step_ns < 0) {
       ++back_steps;
-      back_s = (check.stamps_ns[i] - check.stamps_ns[i - 1]) * 1e-9;
+      back_s = step_ns * 1e-9;
+      jump_at = static_cast<int>(i);
+      ticks_at_jump = ticks;
     }
   }
   EXPECT_EQ(back_steps, 1);
-  // One period forward plus the jump, up to a frame lost around it.
-  EXPECT_NEAR(back_s, kJumpS + 0.1, 0.15);
+  // Exactly the jump plus the periods the images say passed; at most two sets lost around it on a
+  // loaded machine (the jump itself loses none: both cameras jump on the same tick).
+  EXPECT_NEAR(back_s, kJumpS + ticks_at_jump * kPeriodS, 1e-6);
+  EXPECT_GE(ticks_at_jump, 1);
+  EXPECT_LE(ticks_at_jump, 3);
+  // Frames after the jump are kept: the recording goes on to its 45 sets.
+  EXPECT_GE(kSets - jump_at, 10) << "jump at set " << jump_at;
   ASSERT_TRUE(listener.WaitFor([&] { return listener.frames_processed() == kSets; }, 5.0));
-  EXPECT_TRUE(listener.HasEvent("device timestamp went back by"));
-  EXPECT_TRUE(listener.HasEvent("record: frame set", "stamp went back"));
-  // Both cameras jump on the same tick: pairing goes on, at most the set at the jump is lost.
-  EXPECT_LE(listener.statuses().back().frames_dropped, 2);
+  EXPECT_TRUE(listener.HasEvent("127.0.0.2", "device timestamp went back by"));
+  EXPECT_TRUE(listener.HasEvent("127.0.0.3", "device timestamp went back by"));
+  EXPECT_TRUE(listener.HasEvent("record: frame set " + std::to_string(jump_at) + " stamp went back"));
+  EXPECT_NE(result.err.find("stamps went back 1 times (all sets kept)"), std::string::npos) << result.err;
+  // Camera frames lost anywhere in the run (a loaded machine may cost a few), at most the two sets
+  // the tick check allows around the jump plus two elsewhere, on both cameras.
+  const std::int64_t lost = listener.statuses().back().frames_dropped;
+  EXPECT_LE(lost, 8);
   PrintEvents(listener);
-  std::printf("FIGURE stamp_jump %.1f s: %d sets delivered, %lld camera frames lost\n", kJumpS, check.sets,
-              static_cast<long long>(listener.statuses().back().frames_dropped));
+  std::printf("FIGURE stamp_jump %.1f s: %d sets delivered, %d after the jump (at set %d, step %.2f s = jump + %d "
+              "periods), %lld camera frames lost, 1 jump reported per camera and by the recorder\n",
+              kJumpS, check.sets, kSets - jump_at, jump_at, back_s, ticks_at_jump, static_cast<long long>(lost));
 }
 
 TEST(FaultInjectionHilTest, FullDiskStopsTheRecorderWithAClearErrorKeepingEveryCompleteSet) {
@@ -300,86 +380,6 @@ TEST(FaultInjectionHilTest, SigkillDuringRecordingKeepsEveryFlushedSet) {
   std::printf("%s", info.out.c_str());
   std::printf("FIGURE sigkill: %lld sets reported before the kill, %d read back, 0 lost\n",
               static_cast<long long>(reported), check.sets);
-}
-
-
-// A rig cloud as a stereo worker would publish it: ground points in the rig's sector.
-std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std::int64_t sequence, int points) {
-  planning_iface::RigCloud cloud;
-  cloud.rig_id = rig_id;
-  cloud.stamp_ns = stamp_ns;
-  cloud.frame_sequence = sequence;
-  const double yaw = rig_id * 1.047;
-  for (int i = 0; i < points; ++i) {
-    const double range = 2.0 + 0.01 * (i % 800), bearing = yaw + 0.001 * (i % 97);
-    cloud.cloud.PushBack(Eigen::Vector3f(static_cast<float>(range * std::cos(bearing)),
-                                         static_cast<float>(range * std::sin(bearing)), 0.f),
-                         0.02f);
-  }
-  return planning_iface::Encode(cloud);
-}
-
-// TODO(reliability): fuse processed frames with rigs missing and counted 18 of 24 (oversized
-// fragments lost on loopback?); assumptions to re-check.
-TEST(FaultInjectionHilTest, DISABLED_MalformedAndOversizedMessagesAreCountedAndFuseKeepsEveryFrame) {
-  test::ScratchDir dir;
-  const std::string url = LcmUrl(7707);
-  // A small limit for the test: the oversized message (a valid cloud of 30000 points, 240 kB)
-  // must reach fuse whole, which a multi-megabyte burst on loopback might not (socket buffer).
-  constexpr std::size_t kLimit = 100000;
-  Background fuse(RomoBinary() + " fuse --lcm-url '" + url + "' --idle-exit 3 --max-message-bytes " +
-                  std::to_string(kLimit) + " --out " + dir / "fuse" + " >" + dir / "fuse.out" + " 2>" + dir / "fuse.err");
-  const auto started = Clock::now();
-  while (test::ReadFile(dir / "fuse.err").find("listening") == std::string::npos) {
-    ASSERT_LT(SecondsSince(started), 60.0) << test::ReadFile(dir / "fuse.err");
-    ASSERT_TRUE(fuse.running()) << test::ReadFile(dir / "fuse.err");
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  StatusListener listener(url);
-  planning_iface::LcmBus bus(url);
-  constexpr int kFrames = 6, kRigs = 6;
-  int injected = 0;
-  for (int k = 0; k < kFrames; ++k) {
-    const std::int64_t stamp = (k + 1) * 100000000LL;
-    // Four bad messages per frame, before its good clouds: random bytes, a cut message, a cloud
-    // on another rig's channel, and one too large.
-    std::vector<std::uint8_t> noise(64);
-    for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<std::uint8_t>(i * 37 + k);
-    bus.Publish(planning_iface::RigCloudChannel(2), noise);
-    auto cut = RigCloudMessage(3, stamp, k, 100);
-    cut.resize(cut.size() / 2);
-    bus.Publish(planning_iface::RigCloudChannel(3), cut);
-    bus.Publish(planning_iface::RigCloudChannel(4), RigCloudMessage(1, stamp, k, 100));
-    const auto oversized = RigCloudMessage(0, stamp, k, 30000);
-    ASSERT_GT(oversized.size(), kLimit);
-    bus.Publish(planning_iface::RigCloudChannel(0), oversized);
-    injected += 4;
-    for (int rig = 0; rig < kRigs; ++rig) bus.Publish(planning_iface::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, 400));
-    // Lock-step with fuse's status so no socket buffer overflows on a loaded machine.
-    ASSERT_TRUE(listener.WaitFor([&] { return listener.frames_processed() >= k + 1; }, 30.0))
-        << "frame " << k << "\n" << test::ReadFile(dir / "fuse.err");
-  }
-  // fuse ends by itself once the bus is idle (--idle-exit): it kept running through all of it.
-  const int status = fuse.Wait(60.0);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::ReadFile(dir / "fuse.err");
-  const auto statuses = listener.statuses();
-  ASSERT_EQ(statuses.size(), static_cast<std::size_t>(kFrames));
-  for (const auto& s : statuses) {
-    int present = 0;
-    for (const auto& rig : s.rigs) present += rig.present ? 1 : 0;
-    EXPECT_EQ(present, kRigs) << "frame " << s.frame_sequence << " lost a rig to the bad messages";
-  }
-  // Every bad message counted, none taken for a cloud.
-  EXPECT_EQ(statuses.back().malformed_messages, injected);
-  EXPECT_TRUE(listener.HasEvent("oversized message on ROMO_RIG_CLOUD0", std::to_string(kLimit)));
-  EXPECT_TRUE(listener.HasEvent("malformed message on ROMO_RIG_CLOUD2"));
-  EXPECT_TRUE(listener.HasEvent("malformed message on ROMO_RIG_CLOUD4"));
-  const std::string summary = test::ReadFile(dir / "fuse/summary.json");
-  EXPECT_NE(summary.find("\"malformed_messages\": " + std::to_string(injected)), std::string::npos) << summary;
-  PrintEvents(listener);
-  std::printf("FIGURE lcm_injection: %d frames x %d rigs delivered, 0 lost; %d malformed/oversized messages "
-              "injected, %lld counted\n",
-              kFrames, kRigs, injected, static_cast<long long>(statuses.back().malformed_messages));
 }
 
 }  // namespace

@@ -101,6 +101,7 @@ struct Check {
   int consecutive_steps = 0;  // served index advanced by exactly one between sets
   int steps = 0;
   std::vector<std::int64_t> stamps_ns;  // per set
+  std::vector<int> indices;             // per set: the served frame it shows
 };
 
 /// Every recorded image must equal a served one, left and right (and all rigs) the same instant.
@@ -126,6 +127,7 @@ inline Check CheckRecorded(const std::string& path, const Served& served) {
       EXPECT_EQ(left, index) << "rigs of one frame set show different instants";
       EXPECT_EQ(stereo.left.stamp_ns, stereo.right.stamp_ns);
     }
+    check.indices.push_back(index);
     if (set->stereo.size() == served.frames.size()) ++check.complete_sets;
     if (previous >= 0) {
       ++check.steps;
