@@ -16,6 +16,7 @@
 #include <dlfcn.h>
 #include <sys/stat.h>
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include "romo/core/check.hpp"
@@ -33,6 +34,13 @@ const std::set<std::size_t> kDistortionSizes = {0, 4, 5, 8, 12, 14};
 // Six rigs take ~6 KB; the cap keeps yaml-cpp's per-node memory (~100 B each) bounded for
 // hostile text (a recording's calibration message, a fuzzed file).
 constexpr std::size_t kMaxCalibrationBytes = std::size_t{1} << 20;
+// YAML aliases let a small text repeat one huge map many times, and each key lookup scans the
+// map: with 60000 aliases of a 50000-key rig, under 1 MiB of text took minutes. Reading stops at
+// counts no calibration comes near (romo has 6 rigs; a rig map has 9 keys, a matrix 4).
+constexpr std::size_t kMaxRigs = 64;
+constexpr std::size_t kMaxMapKeys = 32;
+// Longest text quoted back in an error message.
+constexpr std::size_t kMaxQuotedChars = 64;
 
 std::string Num(double value) {
   if (std::isnan(value)) return "nan";
@@ -118,8 +126,11 @@ std::string NodeKind(const YAML::Node& node) {
   if (node.IsSequence()) return "a sequence";
   if (node.IsMap()) return "a map";
   if (AsInt(node)) return "an integer";
-  if (AsNumber(node)) return "the number " + node.Scalar();
-  return "the text '" + node.Scalar() + "'";
+  const std::string& text = node.Scalar();
+  const std::string quoted =
+      text.size() <= kMaxQuotedChars ? text : text.substr(0, kMaxQuotedChars) + "...";
+  if (AsNumber(node)) return "the number " + quoted;
+  return "the text '" + quoted + "'";
 }
 
 // A key of a map node; an undefined node for anything else. yaml-cpp's const operator[] throws on
@@ -130,6 +141,26 @@ YAML::Node Child(const YAML::Node& parent, const char* key) {
   const YAML::Node& const_parent = parent;
   const YAML::Node found = const_parent[key];
   return found.IsDefined() ? found : YAML::Node(YAML::NodeType::Undefined);
+}
+
+// A map of at most kMaxMapKeys keys.
+void RequireMap(const YAML::Node& node, const std::string& origin, const std::string& field) {
+  if (!node.IsDefined()) FieldError(origin, field, "missing");
+  if (!node.IsMap()) FieldError(origin, field, "expected a map, got " + NodeKind(node));
+  if (node.size() > kMaxMapKeys) {
+    FieldError(origin, field,
+               "a map of " + std::to_string(node.size()) + " keys, more than the " +
+                   std::to_string(kMaxMapKeys) + " any calibration map has");
+  }
+}
+
+// Refuses a sequence longer than the matrix it fills before reading a single number.
+// @p what names the matrix in the error ("a 3x3 matrix").
+void RequireAtMost(const YAML::Node& seq, std::size_t max_values, const std::string& what,
+                   const std::string& origin, const std::string& field) {
+  if (seq.size() > max_values) {
+    FieldError(origin, field, std::to_string(seq.size()) + " numbers, too many for " + what);
+  }
 }
 
 int ReadInt(const YAML::Node& parent, const char* key, const std::string& origin,
@@ -189,12 +220,13 @@ double StoreAs(char dt, double value) {
 }
 
 // Reads an !!opencv-matrix (or a plain sequence of numbers, as a 1xN row).
-Matrix ReadMat(const YAML::Node& parent, const char* key, const std::string& origin,
-               const std::string& field) {
+Matrix ReadMat(const YAML::Node& parent, const char* key, std::size_t max_values,
+               const std::string& what, const std::string& origin, const std::string& field) {
   const YAML::Node node = Child(parent, key);
   if (!node.IsDefined()) FieldError(origin, field, "missing");
   Matrix mat;
   if (node.IsSequence()) {
+    RequireAtMost(node, max_values, what, origin, field);
     mat.values = ReadNumbers(node, origin, field);
     if (!mat.values.empty()) {
       mat.rows = 1;
@@ -203,6 +235,7 @@ Matrix ReadMat(const YAML::Node& parent, const char* key, const std::string& ori
     return mat;
   }
   if (!node.IsMap()) FieldError(origin, field, "expected a matrix, got " + NodeKind(node));
+  RequireMap(node, origin, field);
   const YAML::Node rows = Child(node, "rows"), cols = Child(node, "cols");
   const YAML::Node dt = Child(node, "dt"), data = Child(node, "data");
   const auto r = AsInt(rows), c = AsInt(cols);
@@ -217,6 +250,7 @@ Matrix ReadMat(const YAML::Node& parent, const char* key, const std::string& ori
   if (!data.IsSequence()) {
     FieldError(origin, field + ".data", "expected a sequence, got " + NodeKind(data));
   }
+  RequireAtMost(data, max_values, what, origin, field + ".data");
   mat.values = ReadNumbers(data, origin, field + ".data");
   if (static_cast<double>(*r) * *c != static_cast<double>(mat.values.size())) {
     FieldError(origin, field,
@@ -233,7 +267,10 @@ Matrix ReadMat(const YAML::Node& parent, const char* key, const std::string& ori
 
 Matrix ReadMatSized(const YAML::Node& parent, const char* key, int rows, int cols,
                     const std::string& origin, const std::string& field) {
-  Matrix mat = ReadMat(parent, key, origin, field);
+  // Up to twice the size is read, so that a near miss (12 numbers for 4x4) is named by its shape.
+  const std::string shape = std::to_string(rows) + "x" + std::to_string(cols);
+  Matrix mat = ReadMat(parent, key, 2 * static_cast<std::size_t>(rows * cols), "a " + shape + " matrix",
+                       origin, field);
   // Hand-written files may give a plain row-major list of numbers instead of an opencv-matrix.
   if (mat.rows == 1 && mat.cols == rows * cols) {
     mat.rows = rows;
@@ -266,13 +303,14 @@ CameraIntrinsics ReadCamera(const YAML::Node& parent, const char* key, const std
                             const std::string& field) {
   const YAML::Node node = Child(parent, key);
   if (!node.IsDefined()) FieldError(origin, field, "missing");
-  if (!node.IsMap()) FieldError(origin, field, "expected a map, got " + NodeKind(node));
+  RequireMap(node, origin, field);
   CameraIntrinsics camera;
   CopyTo(ReadMatSized(node, "K", 3, 3, origin, field + ".K"), &camera.K);
   if (!Child(node, "distortion").IsDefined()) {
     FieldError(origin, field + ".distortion", "missing (write [] for none)");
   }
-  const Matrix d = ReadMat(node, "distortion", origin, field + ".distortion");
+  const Matrix d = ReadMat(node, "distortion", *kDistortionSizes.rbegin(),
+                           "a distortion model (at most 14)", origin, field + ".distortion");
   if (!d.values.empty() && d.rows != 1 && d.cols != 1) {
     FieldError(origin, field + ".distortion",
                "expected a vector, got " + std::to_string(d.rows) + "x" + std::to_string(d.cols));
@@ -400,11 +438,16 @@ Calibration Parse(const YAML::Node& root, const std::string& origin) {
   const YAML::Node rigs = Child(root, "rigs");
   if (!rigs.IsDefined()) FieldError(origin, "rigs", "missing");
   if (!rigs.IsSequence()) FieldError(origin, "rigs", "expected a sequence, got " + NodeKind(rigs));
+  if (rigs.size() > kMaxRigs) {
+    FieldError(origin, "rigs",
+               std::to_string(rigs.size()) + " rigs, more than the " + std::to_string(kMaxRigs) +
+                   " a calibration may hold");
+  }
   Calibration calibration;
   int index = 0;
   for (const auto& node : rigs) {
     const std::string f = "rigs[" + std::to_string(index++) + "]";
-    if (!node.IsMap()) FieldError(origin, f, "expected a map, got " + NodeKind(node));
+    RequireMap(node, origin, f);
     RigCalibration rig;
     rig.rig_id = ReadInt(node, "id", origin, f + ".id");
     rig.name = ReadString(node, "name", origin, f + ".name");
@@ -440,7 +483,11 @@ Calibration ParseText(std::string text, const std::string& origin) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {  // DeepRecursion (nesting > 2000) is one too
+  } catch (const YAML::DeepRecursion& e) {  // yaml-cpp's own message for it is "bad file"
+    Fail(origin + ": not a valid YAML calibration: line " + std::to_string(e.mark.line + 1) +
+         ", column " + std::to_string(e.mark.column + 1) + ": nested " +
+         std::to_string(e.depth()) + " levels deep, deeper than the YAML reader allows");
+  } catch (const YAML::ParserException& e) {
     Fail(origin + ": not a valid YAML calibration: line " + std::to_string(e.mark.line + 1) +
          ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
@@ -459,6 +506,11 @@ const RigCalibration& Calibration::rig(int rig_id) const {
 
 void Calibration::Validate(const std::string& origin) const {
   if (rigs.empty()) FieldError(origin, "rigs", "no rigs");
+  if (rigs.size() > kMaxRigs) {  // as Load refuses it, so that what Save writes loads again
+    FieldError(origin, "rigs",
+               std::to_string(rigs.size()) + " rigs, more than the " + std::to_string(kMaxRigs) +
+                   " a calibration may hold");
+  }
   std::set<int> ids;
   for (std::size_t i = 0; i < rigs.size(); ++i) {
     const RigCalibration& rig = rigs[i];

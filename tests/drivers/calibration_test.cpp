@@ -403,6 +403,37 @@ TEST(CalibrationTest, DocumentThatHungOpenCvFailsFastNamingTheLine) {
   EXPECT_LT(seconds, kMaxParseS);
 }
 
+TEST(CalibrationTest, AliasedHugeMapsAreRefusedBeforeTheyAreSearched) {
+  // YAML aliases repeat one node for free; each key lookup scans its map. 60000 aliases of a
+  // 50000-key rig (< 1 MiB) kept the reader busy for minutes before the counts were capped.
+  std::string junk;
+  for (int i = 0; i < 40; ++i) junk += "k" + std::to_string(i) + ": 0, ";
+  const std::string rig = "{ " + junk +
+                          "id: 0, name: front, image_width: 782, image_height: 582, "
+                          "left: { K: [400, 0, 390.5, 0, 400, 290.5, 0, 0, 1], distortion: [] }, "
+                          "right: { K: [400, 0, 390.5, 0, 400, 290.5, 0, 0, 1], distortion: [] }, "
+                          "R: [1, 0, 0, 0, 1, 0, 0, 0, 1], T: [-0.25, 0, 0], "
+                          "T_vehicle_rig: [0, 0, 1, 1.4, -1, 0, 0, 0, 0, -1, 0, 1.2, 0, 0, 0, 1] }";
+  std::string aliases;
+  for (int i = 0; i < 1000; ++i) aliases += std::string(i ? ", " : "") + "*a";
+  EXPECT_EQ(test::ErrorOf([&] {
+              Calibration::FromYaml("base: &a " + rig + "\nrigs: [" + aliases + "]\n", "alias.yaml");
+            }),
+            "alias.yaml: rigs: 1000 rigs, more than the 64 a calibration may hold");
+  EXPECT_EQ(test::ErrorOf([&] { Calibration::FromYaml("base: &a " + rig + "\nrigs: [*a]\n", "alias.yaml"); }),
+            "alias.yaml: rigs[0]: a map of 49 keys, more than the 32 any calibration map has");
+  std::string long_list = "[1";
+  for (int i = 0; i < 100; ++i) long_list += ", 0";
+  EXPECT_EQ(YamlError({{"R", long_list + "]"}}),
+            "hand.yaml: rigs[0].R: 101 numbers, too many for a 3x3 matrix");
+}
+
+TEST(CalibrationTest, DeepNestingIsRefusedNamingTheDepth) {
+  EXPECT_EQ(test::ErrorOf([] { Calibration::FromYaml(std::string(5000, '['), "deep.yaml"); }),
+            "deep.yaml: not a valid YAML calibration: line 1, column 1: nested 500 levels deep, "
+            "deeper than the YAML reader allows");
+}
+
 TEST(CalibrationTest, OversizedTextIsRefusedBeforeParsing) {
   const std::string text = "%YAML:1.0\n---\nrigs: [" + std::string(2 << 20, ' ') + "]\n";
   EXPECT_EQ(test::ErrorOf([&] { Calibration::FromYaml(text, "big.yaml"); }),
