@@ -97,6 +97,27 @@ TEST(ObjectFunctionsTest, BadYamlNamesFileLineFieldAndValue) {
             std::string::npos)
       << e;
 
+  // Aliases cannot multiply texts without bound (3000 objects aliasing one: 180 MB from 55 KB).
+  e = test::ErrorOf([] {
+    std::string many = WithHammer("  hammer: &h\n    interaction_plane: table\n    functions:\n"
+                                  "      - {label: hitting, motion: m, pattern: p}\n"
+                                  "      - {label: pulling, motion: m, pattern: p}\n");
+    for (int i = 0; i < 300; ++i) many += "  copy" + std::to_string(i) + ": *h\n";
+    ObjectFunctionAtlas::Parse(many, "a.yaml");
+  });
+  EXPECT_NE(e.find("field 'objects' = '307 objects': more than 256"), std::string::npos) << e;
+  e = test::ErrorOf([] {
+    ObjectFunctionAtlas::Parse(WithHammer("  hammer:\n    interaction_plane: table\n    functions:\n"
+                                          "      - {label: hitting, motion: " + std::string(1001, 'm') +
+                                          ", pattern: p}\n"
+                                          "      - {label: pulling, motion: m, pattern: p}\n"),
+                               "a.yaml");
+  });
+  EXPECT_NE(e.find("objects.hammer.functions[0].motion' = '" + std::string(40, 'm') +
+                   "...': 1001 characters, more than 1000"),
+            std::string::npos)
+      << e;
+
   // Removing pulling leaves an action the plugin reports without any object to explain it.
   e = test::ErrorOf([] {
     ObjectFunctionAtlas::Parse(WithHammer("  hammer:\n    interaction_plane: table\n    functions:\n"
