@@ -2,11 +2,20 @@
 // publish. Frames are assembled by stamp; a rig that has not arrived within --timeout-ms is
 // reported missing (sector not covered) and the frame goes on without it. Malformed messages
 // are counted and reported, never fatal.
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -27,9 +36,102 @@ struct FuseOptions {
   int timeout_ms = 500;
   double idle_exit_s = 10.0;
   long long frames = 0;
+  bool no_pictures = false;
   // A full-resolution rig cloud (782 x 582 points at 8 bytes) is 3.6 MB; anything far larger is
   // refused before decoding so a bad or hostile sender cannot make fuse allocate without bound.
   std::size_t max_message_bytes = 8u << 20;
+  // Kernel UDP receive buffer asked for on udpm:// (LCM's recv_buf_size) unless the URL sets one.
+  // The default 208 kB holds less than one half-resolution frame of six rig clouds: on a busy
+  // machine LCM's reader thread falls behind a burst and the kernel drops fragments unseen
+  // (measured: 5 of 8 frames arrived, each with 1 of 6 rigs). 32 MB holds a few full-resolution
+  // frames (6 x 3.6 MB); the kernel caps it at net.core.rmem_max.
+  long long recv_buf_bytes = 32ll << 20;
+};
+
+// @p url with recv_buf_size=@p bytes added when it is udpm:// and sets none.
+std::string WithReceiveBuffer(const std::string& url, long long bytes) {
+  if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size=") != std::string::npos || bytes <= 0) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(bytes);
+}
+
+// net.core.rmem_max (the most SO_RCVBUF may ask for), or -1 when unreadable (not Linux).
+long long KernelReceiveBufferMax() {
+  std::ifstream in("/proc/sys/net/core/rmem_max");
+  long long v = -1;
+  return (in >> v) ? v : -1;
+}
+
+// One message off the bus. Oversized ones keep only their size (never copied), and so do the
+// ones that found the queue full (overflow).
+struct Received {
+  std::string channel;
+  std::size_t size = 0;
+  std::vector<std::uint8_t> data;
+  bool overflow = false;
+};
+
+// Takes messages off LCM on a thread of its own, so none is lost while a frame is being fused:
+// LCM queues at most 30 messages per subscription and drops the rest unseen, fewer than a few
+// frames of six rigs. Bounded by bytes; what does not fit is counted, not silently lost.
+class Inbox {
+ public:
+  Inbox(const std::string& url, std::size_t max_message_bytes, std::size_t max_queued_bytes)
+      : bus_(url), max_message_bytes_(max_message_bytes), max_queued_bytes_(max_queued_bytes) {
+    bus_.Subscribe(std::string(planning_iface::kRigCloudChannelPrefix) + "[0-9]+",
+                   [this](const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
+                     Received m;
+                     m.channel = channel;
+                     m.size = size;
+                     if (size <= max_message_bytes_) m.data.assign(data, data + size);
+                     std::lock_guard<std::mutex> lock(mutex_);
+                     if (queued_bytes_ + m.data.size() > max_queued_bytes_) {
+                       m.overflow = true;
+                       m.data.clear();
+                     }
+                     queued_bytes_ += m.data.size();
+                     queue_.push_back(std::move(m));
+                     ready_.notify_one();
+                   });
+    thread_ = std::thread([this] {
+      try {
+        while (!stop_) bus_.Handle(50);
+      } catch (const std::exception& e) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = e.what();
+        ready_.notify_one();
+      }
+    });
+  }
+  ~Inbox() {
+    stop_ = true;
+    thread_.join();
+  }
+  Inbox(const Inbox&) = delete;
+  Inbox& operator=(const Inbox&) = delete;
+
+  /// Everything received so far, waiting up to @p timeout_ms for the first message.
+  /// @throws romo::Error when LCM failed on the receiving thread.
+  std::deque<Received> Take(int timeout_ms) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ready_.wait_for(lock, std::chrono::milliseconds(timeout_ms),
+                    [this] { return !queue_.empty() || !error_.empty(); });
+    if (!error_.empty()) Fail("fuse: " + error_);
+    std::deque<Received> out;
+    out.swap(queue_);
+    queued_bytes_ = 0;
+    return out;
+  }
+
+ private:
+  planning_iface::LcmBus bus_;
+  const std::size_t max_message_bytes_, max_queued_bytes_;
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<Received> queue_;
+  std::size_t queued_bytes_ = 0;
+  std::string error_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
 };
 
 void Fuse(const FuseOptions& o) {
@@ -42,7 +144,12 @@ void Fuse(const FuseOptions& o) {
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
   out.log_inputs = false;
+  out.frame_pictures = !o.no_pictures;
   pipeline::OutputSink sink(calibration, out);
+  // Stereo workers carry odometry with each cloud but no GNSS fix: geodetic outputs (the WGS84
+  // column of the pedestrian predictions) are relative to lat 0, lon 0 and say so.
+  pipe.ReportEvent("fuse: no GNSS on the bus (stereo workers carry odometry only): geodetic outputs unavailable, "
+                   "WGS84 is relative to lat 0, lon 0");
 
   struct Pending {
     Clock::time_point first_arrival;
@@ -52,51 +159,78 @@ void Fuse(const FuseOptions& o) {
   };
   std::map<std::int64_t, Pending> pending;  // by stamp
   std::int64_t last_done_stamp = -1;
+  // Newest stamp each rig has delivered: a worker publishes in stamp order, so a rig that has
+  // sent a newer frame will not send an older one it skipped (no need to wait out the timeout).
+  std::map<int, std::int64_t> newest_stamp;
   long long processed = 0, late = 0;
-  auto last_message = Clock::now();
+  // The idle clock starts with the first message: workers may take a while to start (loading,
+  // first stereo), and fuse is a service that waits for them.
+  std::optional<Clock::time_point> last_message;
 
-  planning_iface::LcmBus bus(o.lcm_url);
-  bus.Subscribe(std::string(planning_iface::kRigCloudChannelPrefix) + "[0-9]+",
-                [&](const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
-                  last_message = Clock::now();
-                  if (size > o.max_message_bytes) {
-                    pipe.CountMalformed();
-                    pipe.ReportEvent("oversized message on " + channel + ": " + std::to_string(size) +
-                                     " bytes > --max-message-bytes " + std::to_string(o.max_message_bytes) +
-                                     "; dropped undecoded");
-                    return;
-                  }
-                  std::string why;
-                  auto rc = planning_iface::DecodeRigCloud(data, size, &why);
-                  if (!rc || channel != planning_iface::RigCloudChannel(rc->rig_id)) {
-                    pipe.CountMalformed();
-                    pipe.ReportEvent("malformed message on " + channel + ": " +
-                                     (why.empty() ? "rig id does not match the channel" : why));
-                    return;
-                  }
-                  bool known = false;
-                  for (const auto& r : calibration.rigs) known = known || r.rig_id == rc->rig_id;
-                  if (!known) {
-                    pipe.CountMalformed();
-                    pipe.ReportEvent("cloud of rig " + std::to_string(rc->rig_id) + " not in the calibration");
-                    return;
-                  }
-                  if (rc->stamp_ns <= last_done_stamp) {
-                    ++late;  // its frame was already processed without it
-                    pipe.CountDropped(rc->rig_id);
-                    return;
-                  }
-                  Pending& p = pending[rc->stamp_ns];
-                  if (p.rigs.empty()) p.first_arrival = Clock::now();
-                  p.sequence = rc->frame_sequence;
-                  if (rc->vehicle) p.vehicle = rc->vehicle;
-                  pipeline::RigInput in;
-                  in.rig_id = rc->rig_id;
-                  in.stamp_ns = rc->stamp_ns;
-                  in.cloud = std::move(rc->cloud);
-                  in.stereo_ms = rc->stereo_ms;
-                  p.rigs[in.rig_id] = std::move(in);
-                });
+  // Asking for more than the cap only makes LCM print a warning; the cap is reported here.
+  const long long rmem_max = KernelReceiveBufferMax();
+  const long long asked = rmem_max > 0 ? std::min(o.recv_buf_bytes, rmem_max) : o.recv_buf_bytes;
+  const std::string receive_url = WithReceiveBuffer(o.lcm_url, asked);
+  if (receive_url != o.lcm_url && asked < o.recv_buf_bytes) {
+    pipe.ReportEvent("fuse: kernel UDP receive buffer capped at " + std::to_string(rmem_max) +
+                     " bytes by net.core.rmem_max (asked " + std::to_string(o.recv_buf_bytes) +
+                     "): bursts of rig clouds beyond it are lost unseen; raise net.core.rmem_max");
+  }
+  // Up to 64 of the largest messages accepted (512 MB at the default limit) wait for fusion.
+  Inbox inbox(receive_url, o.max_message_bytes, std::max<std::size_t>(64 * o.max_message_bytes, 512u << 20));
+  auto on_message = [&](const Received& m) {
+    const std::string& channel = m.channel;
+    const std::size_t size = m.size;
+    last_message = Clock::now();
+    if (m.overflow) {
+      const int rig = std::atoi(channel.c_str() + std::string(planning_iface::kRigCloudChannelPrefix).size());
+      pipe.CountDropped(rig);
+      pipe.ReportEvent("fuse behind: a " + std::to_string(size) + "-byte message on " + channel +
+                       " dropped, the receive queue was full");
+      return;
+    }
+    if (size > o.max_message_bytes) {
+      pipe.CountMalformed();
+      pipe.ReportEvent("oversized message on " + channel + ": " + std::to_string(size) +
+                       " bytes > --max-message-bytes " + std::to_string(o.max_message_bytes) +
+                       "; dropped undecoded");
+      return;
+    }
+    std::string why;
+    auto rc = planning_iface::DecodeRigCloud(m.data.data(), size, &why);
+    if (!rc || channel != planning_iface::RigCloudChannel(rc->rig_id)) {
+      pipe.CountMalformed();
+      pipe.ReportEvent("malformed message on " + channel + ": " +
+                       (why.empty() ? "rig id does not match the channel" : why));
+      return;
+    }
+    bool known = false;
+    for (const auto& r : calibration.rigs) known = known || r.rig_id == rc->rig_id;
+    if (!known) {
+      pipe.CountMalformed();
+      pipe.ReportEvent("cloud of rig " + std::to_string(rc->rig_id) + " not in the calibration");
+      return;
+    }
+    if (rc->stamp_ns <= last_done_stamp) {
+      ++late;  // its frame was already processed without it
+      pipe.CountDropped(rc->rig_id);
+      pipe.ReportEvent("late cloud of rig " + std::to_string(rc->rig_id) + " for frame " +
+                       std::to_string(rc->frame_sequence) + ": its frame was fused without it");
+      return;
+    }
+    std::int64_t& newest = newest_stamp[rc->rig_id];
+    newest = std::max(newest, rc->stamp_ns);
+    Pending& p = pending[rc->stamp_ns];
+    if (p.rigs.empty()) p.first_arrival = Clock::now();
+    p.sequence = rc->frame_sequence;
+    if (rc->vehicle) p.vehicle = rc->vehicle;
+    pipeline::RigInput in;
+    in.rig_id = rc->rig_id;
+    in.stamp_ns = rc->stamp_ns;
+    in.cloud = std::move(rc->cloud);
+    in.stereo_ms = rc->stereo_ms;
+    p.rigs[in.rig_id] = std::move(in);
+  };
 
   auto process = [&](std::map<std::int64_t, Pending>::iterator it) {
     std::vector<pipeline::RigInput> rigs;
@@ -113,22 +247,29 @@ void Fuse(const FuseOptions& o) {
   std::fprintf(stderr, "romo fuse: listening on %s for %zu rigs\n", o.lcm_url.c_str(), all);
   std::fflush(stderr);
   while (o.frames <= 0 || processed < o.frames) {
-    bus.Handle(20);
+    for (const Received& m : inbox.Take(20)) on_message(m);
     // Oldest first: complete frames at once, incomplete ones after the timeout or when a newer
     // frame is already complete (its rigs will not come back for the old stamp).
     while (!pending.empty()) {
       auto it = pending.begin();
       const bool complete = it->second.rigs.size() >= all;
+      // Every absent rig has already moved on to a newer frame: nothing more will come.
+      bool skipped = true;
+      for (const auto& rig : calibration.rigs) {
+        if (it->second.rigs.count(rig.rig_id)) continue;
+        const auto n = newest_stamp.find(rig.rig_id);
+        skipped = skipped && n != newest_stamp.end() && n->second > it->first;
+      }
       const bool timed_out = Clock::now() - it->second.first_arrival > std::chrono::milliseconds(o.timeout_ms);
       bool newer_complete = false;
       for (auto jt = std::next(it); jt != pending.end(); ++jt) newer_complete |= jt->second.rigs.size() >= all;
-      if (!(complete || timed_out || newer_complete)) break;
+      if (!(complete || skipped || timed_out || newer_complete)) break;
       process(it);
     }
-    if (Clock::now() - last_message > std::chrono::duration<double>(o.idle_exit_s)) break;
+    if (last_message && Clock::now() - *last_message > std::chrono::duration<double>(o.idle_exit_s)) break;
   }
   while (!pending.empty() && (o.frames <= 0 || processed < o.frames)) process(pending.begin());
-  sink.Finish("\"late_clouds\": " + std::to_string(late));
+  sink.Finish("\"late_clouds\": " + std::to_string(late) + ", \"geodetic\": false");
   std::fprintf(stderr, "romo fuse: %lld frames processed, %lld late clouds\n", processed, late);
 }
 
@@ -141,12 +282,17 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--calib", opts->calib, "calibration (default: the sample RoMo calibration)");
   cmd->add_option("--out", opts->out_dir, "also write outputs like romo replay");
   cmd->add_option("--timeout-ms", opts->timeout_ms, "wait this long for a frame's missing rigs")->capture_default_str();
-  cmd->add_option("--idle-exit", opts->idle_exit_s, "exit after this many seconds without messages")->capture_default_str();
+  cmd->add_option("--idle-exit", opts->idle_exit_s, "exit after this many seconds without messages (counted from the first)")->capture_default_str();
   cmd->add_option("--frames", opts->frames, "exit after this many frames (0 = until idle)");
+  cmd->add_flag("--no-pictures", opts->no_pictures, "skip the per-frame top-view PNGs (with --out)");
   cmd->add_option("--max-message-bytes", opts->max_message_bytes,
                   "refuse (count as malformed) rig clouds larger than this")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--recv-buf-bytes", opts->recv_buf_bytes,
+                  "kernel UDP receive buffer to ask for on udpm:// (0 = the system default)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([opts] { Fuse(*opts); });
 });
 
