@@ -236,6 +236,21 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
       ++slots_compared;
     }
   }
+  // What fuse cannot do is said in its first status: no GNSS reaches it (geodetic outputs
+  // unavailable), and a kernel cap on its receive buffer below the 32 MB it asks for.
+  const auto has_event = [&](const std::string& text) {
+    for (const auto& e : fused.statuses.begin()->second.events) {
+      if (e.find(text) != std::string::npos) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(has_event("geodetic outputs unavailable"));
+  long long rmem_max = -1;
+  std::sscanf(test::ReadFile("/proc/sys/net/core/rmem_max").c_str(), "%lld", &rmem_max);
+  EXPECT_EQ(has_event("capped at " + std::to_string(rmem_max) + " bytes by net.core.rmem_max"),
+            rmem_max >= 0 && rmem_max < (32ll << 20));
+  EXPECT_NE(test::ReadFile(dir / "fuse/summary.json").find("\"geodetic\": false"), std::string::npos);
+
   // The recording's window must exercise the comparison: obstacles and a slot in it.
   ASSERT_GE(obstacles_compared, kFrames);
   EXPECT_GE(slots_compared, kFrames - 1);
