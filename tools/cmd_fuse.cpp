@@ -269,6 +269,8 @@ void Fuse(const FuseOptions& o) {
     if (last_message && Clock::now() - *last_message > std::chrono::duration<double>(o.idle_exit_s)) break;
   }
   while (!pending.empty() && (o.frames <= 0 || processed < o.frames)) process(pending.begin());
+  // Faults found after the last frame (bad or late messages) still reach the status and summary.
+  if (auto status = pipe.TakePendingStatus()) sink.WriteStatus(*status);
   sink.Finish("\"late_clouds\": " + std::to_string(late) + ", \"geodetic\": false");
   std::fprintf(stderr, "romo fuse: %lld frames processed, %lld late clouds\n", processed, late);
 }

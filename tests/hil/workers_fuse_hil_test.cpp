@@ -382,12 +382,21 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     for (int rig = 0; rig < kRigs; ++rig) bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints));
     // No lock-step with fuse: the bursts come as fast as this thread can send them.
   }
+  // Two more after the last frame: counted in a status of their own if the last frame is fused
+  // before they arrive.
+  bus.Publish(pi::RigCloudChannel(2), std::vector<std::uint8_t>(16, 0xff));
+  bus.Publish(pi::RigCloudChannel(0), RigCloudMessage(0, (kInjectedFrames + 1) * 100000000LL, kInjectedFrames, 30000));
+  constexpr int kTrailing = 2;
   // fuse ends by itself once the bus is idle (--idle-exit): it kept running through all of it.
   const int status = fuse->Wait(60.0);
   ASSERT_TRUE(ExitedCleanly(status)) << test::ReadFile(dir / "fuse.err");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last status on its way
-  const auto statuses = listener.statuses();
-  ASSERT_EQ(statuses.size(), static_cast<std::size_t>(kInjectedFrames)) << test::ReadFile(dir / "fuse.err");
+  auto statuses = listener.statuses();
+  ASSERT_GE(statuses.size(), static_cast<std::size_t>(kInjectedFrames)) << test::ReadFile(dir / "fuse.err");
+  ASSERT_LE(statuses.size(), static_cast<std::size_t>(kInjectedFrames + 1));
+  const pi::PerceptionStatus last = statuses.back();
+  EXPECT_EQ(last.frames_processed, kInjectedFrames);
+  statuses.resize(kInjectedFrames);  // the frames' own
   for (std::size_t k = 0; k < statuses.size(); ++k) {
     const auto& s = statuses[k];
     EXPECT_EQ(s.frame_sequence, static_cast<std::int64_t>(k));
@@ -397,7 +406,8 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     // (later ones may be too: fuse takes whatever has arrived before fusing).
     EXPECT_GE(s.malformed_messages, static_cast<std::int64_t>(kBadPerFrame * (k + 1)));
   }
-  const int injected = kBadPerFrame * kInjectedFrames;
+  const int injected = kBadPerFrame * kInjectedFrames + kTrailing;
+  EXPECT_EQ(last.malformed_messages, injected);
   // Each kind rejected with its reason, once per frame.
   int oversized = 0, undecodable2 = 0, cut3 = 0, wrong_channel4 = 0;
   for (const auto& e : listener.events()) {
@@ -408,8 +418,8 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     wrong_channel4 += e.find("malformed message on ROMO_RIG_CLOUD4: rig id does not match the channel") !=
                       std::string::npos;
   }
-  EXPECT_EQ(oversized, kInjectedFrames);
-  EXPECT_EQ(undecodable2, kInjectedFrames);
+  EXPECT_EQ(oversized, kInjectedFrames + 1);
+  EXPECT_EQ(undecodable2, kInjectedFrames + 1);
   EXPECT_EQ(cut3, kInjectedFrames);
   EXPECT_EQ(wrong_channel4, kInjectedFrames);
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
@@ -421,8 +431,9 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     }
   }
   std::printf("FIGURE lcm_injection: %d frames x %d rigs delivered whole; %d malformed/oversized messages "
-              "injected, %lld counted\n",
-              kInjectedFrames, kRigs, injected, static_cast<long long>(statuses.back().malformed_messages));
+              "injected (%d after the last frame), %lld counted; %zu statuses\n",
+              kInjectedFrames, kRigs, injected, kTrailing, static_cast<long long>(last.malformed_messages),
+              listener.statuses().size());
 }
 
 }  // namespace
