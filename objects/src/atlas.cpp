@@ -131,6 +131,10 @@ Atlas Atlas::Parse(const std::string& yaml_text, const std::string& source) {
               "width must not exceed length (length is the longer footprint side)");
         }
       }
+      if (c["prior"].IsDefined()) {
+        oc.prior = Number(c, "prior", p + ".prior", source);
+        if (!(oc.prior > 0.0 && oc.prior <= 1.0)) Bad(source, p + ".prior", Text(c["prior"]), "need 0 < prior <= 1");
+      }
       const YAML::Node attr = c["attributes"];
       if (attr.IsDefined()) {
         if (!attr.IsMap()) Bad(source, p + ".attributes", Text(attr), "need a mapping");
@@ -198,10 +202,11 @@ Classification Atlas::Classify(double length_m, double width_m, double height_m)
     Fail(m.str());
   }
   Classification best{unknown_, 0.0};
-  double best_score = 0.0;
+  double best_score = 0.0, best_weighted = 0.0;
   for (std::size_t i = 0; i < classes_.size(); ++i) {
     const double s = Score(static_cast<int>(i), length_m, width_m, height_m);
-    if (s > best_score) {
+    if (s * classes_[i].prior > best_weighted) {
+      best_weighted = s * classes_[i].prior;
       best_score = s;
       best.class_index = static_cast<int>(i);
     }

@@ -62,13 +62,16 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
 
   ViewedBox out;
   out.box = box;
+  // score: how well the class's sizes explain the box; weight: that times the class's prior,
+  // which ranks the candidates.
   struct Candidate {
     double score;
     int class_index;
     int length_axis;
+    double weight;
   };
   std::vector<Candidate> candidates;
-  double best_score = 0.0;
+  double best_weight = 0.0;
   int best_class = -1, best_length_axis = 0;
   for (std::size_t c = 0; c < atlas.classes().size(); ++c) {
     const ObjectClass& cls = atlas.classes()[c];
@@ -80,12 +83,13 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
       const double l = ExtentCost(cls.length, extent[length_axis], truncated_axis == length_axis);
       const double w = ExtentCost(cls.width, extent[width_axis], truncated_axis == width_axis);
       if (l < 0 || w < 0) continue;
-      candidates.push_back({std::exp(-0.5 * (l + w + h)), static_cast<int>(c), length_axis});
+      const double score = std::exp(-0.5 * (l + w + h));
+      candidates.push_back({score, static_cast<int>(c), length_axis, score * cls.prior});
     }
   }
   for (const Candidate& k : candidates) {
-    if (k.score > best_score) {
-      best_score = k.score;
+    if (k.weight > best_weight) {
+      best_weight = k.weight;
       best_class = k.class_index;
       best_length_axis = k.length_axis;
     }
@@ -95,17 +99,18 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
       const ObjectClass& cls = atlas.classes()[static_cast<std::size_t>(k.class_index)];
       return k.length_axis == truncated_axis ? cls.length.mean_m : cls.width.mean_m;
     };
-    double least = completed_extent({best_score, best_class, best_length_axis});
+    double least = completed_extent({0.0, best_class, best_length_axis, best_weight});
     for (const Candidate& k : candidates) {
-      if (k.score * params.ambiguity_ratio >= best_score && completed_extent(k) < least) {
+      if (k.weight * params.ambiguity_ratio >= best_weight && completed_extent(k) < least) {
         least = completed_extent(k);
         best_class = k.class_index;
         best_length_axis = k.length_axis;
       }
     }
-    for (const Candidate& k : candidates) {
-      if (k.class_index == best_class && k.length_axis == best_length_axis) best_score = k.score;
-    }
+  }
+  double best_score = 0.0;
+  for (const Candidate& k : candidates) {
+    if (k.class_index == best_class && k.length_axis == best_length_axis) best_score = k.score;
   }
   if (best_class < 0 || best_score < atlas.min_score()) {
     out.classification = {atlas.unknown_index(), 1.0 - best_score};

@@ -1,5 +1,6 @@
 #include "romo/stereo/reprojection.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -13,6 +14,14 @@ void ReprojectionParams::Validate() const {
   }
   if (!(max_range_m > 0.0)) {
     Fail("ReprojectionParams.max_range_m = " + std::to_string(max_range_m) + ": must be > 0");
+  }
+  if (!(min_outline_step_px >= 0.0) || !std::isfinite(min_outline_step_px)) {
+    Fail("ReprojectionParams.min_outline_step_px = " + std::to_string(min_outline_step_px) +
+         ": must be finite and >= 0");
+  }
+  if (!(max_disparity_spread >= 0.0) || !std::isfinite(max_disparity_spread)) {
+    Fail("ReprojectionParams.max_disparity_spread = " + std::to_string(max_disparity_spread) +
+         ": must be finite and >= 0");
   }
 }
 
@@ -47,6 +56,29 @@ PointCloud ReprojectDisparity(const cv::Mat& disparity, int subpixel_scale, int 
   const float sigma_factor = static_cast<float>(params.sigma_d_px) / bf;  // sigma_z = Z^2 * this
   const float max_range2 = static_cast<float>(params.max_range_m * params.max_range_m);
   const bool is16 = disparity.type() == CV_16SC1;
+  const auto raw_at = [&](int v, int u) -> int {
+    return is16 ? disparity.at<short>(v, u) : disparity.at<std::uint8_t>(v, u);
+  };
+  const float max_spread = static_cast<float>(params.max_disparity_spread);
+  const float min_step_raw = static_cast<float>(params.min_outline_step_px) * static_cast<float>(subpixel_scale);
+  // True when the valid disparities around (v, u) span more than max_spread of @p raw (and more
+  // than the floor).
+  const auto on_outline = [&](int v, int u, int raw) {
+    int lo = raw, hi = raw;
+    for (int dv = -1; dv <= 1; ++dv) {
+      const int vv = v + dv;
+      if (vv < 0 || vv >= disparity.rows) continue;
+      for (int du = -1; du <= 1; ++du) {
+        const int uu = u + du;
+        if (uu < 0 || uu >= disparity.cols) continue;
+        const int r = raw_at(vv, uu);
+        if (r == invalid_disparity || r <= 0) continue;
+        lo = std::min(lo, r);
+        hi = std::max(hi, r);
+      }
+    }
+    return static_cast<float>(hi - lo) > std::max(min_step_raw, max_spread * static_cast<float>(raw));
+  };
 
   PointCloud cloud;
   cloud.Resize(static_cast<std::size_t>(disparity.total()));
@@ -58,6 +90,7 @@ PointCloud ReprojectDisparity(const cv::Mat& disparity, int subpixel_scale, int 
     for (int u = 0; u < disparity.cols; ++u) {
       const int raw = is16 ? row16[u] : row8[u];
       if (raw == invalid_disparity || raw <= 0) continue;
+      if (max_spread > 0.f && on_outline(v, u, raw)) continue;
       const float d = static_cast<float>(raw) * inv_scale;
       // Eq. 2.2 (pixel units): Z = b f / d, X = b (u - u0) / d, Y = b (v - v0) / d.
       const float z = bf / d;

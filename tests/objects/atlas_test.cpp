@@ -1,4 +1,6 @@
 // Atlas classes from config/atlas.yaml: classification of boxes by size priors, validation.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "romo/core/check.hpp"
@@ -57,6 +59,25 @@ classes:
   EXPECT_EQ(NameOf(atlas, atlas.Classify(0.92, 0.56, 1.02)), "shopping_cart");
 }
 
+// Two classes with the same size priors explain a box equally well: the prior decides, and the
+// score reported stays the size likelihood (what min_score is compared with).
+TEST(AtlasTest, PriorDecidesBetweenEquallyFittingClasses) {
+  const std::string sizes =
+      "    length_m: {mean: 1.0, sigma: 0.2, min: 0.5, max: 1.5}\n"
+      "    width_m: {mean: 0.5, sigma: 0.1, min: 0.3, max: 0.7}\n"
+      "    height_m: {mean: 1.0, sigma: 0.2, min: 0.5, max: 1.5}\n";
+  const Atlas atlas = Atlas::Parse("classes:\n  - name: rare\n    prior: 0.2\n" + sizes +
+                                       "  - name: common\n" + sizes + "  - name: unknown\n",
+                                   "inline");
+  EXPECT_DOUBLE_EQ(atlas.classes()[atlas.Require("rare")].prior, 0.2);
+  EXPECT_DOUBLE_EQ(atlas.classes()[atlas.Require("common")].prior, 1.0);  // the default
+  const Classification c = atlas.Classify(1.1, 0.5, 1.0);
+  EXPECT_EQ(NameOf(atlas, c), "common");
+  EXPECT_NEAR(c.score, std::exp(-0.5 * 0.25), 1e-12);  // (1.1 - 1.0) / 0.2 = 0.5 sigma
+  // The shipped Atlas: a cyclist-sized box is still a cyclist when nothing else fits.
+  EXPECT_EQ(NameOf(Load(), Load().Classify(1.7, 0.6, 1.65)), "cyclist");
+}
+
 void ExpectError(const std::string& yaml, const std::string& needle) {
   try {
     Atlas::Parse(yaml, "bad.yaml");
@@ -84,6 +105,8 @@ TEST(AtlasTest, BadFilesNameFileFieldAndValue) {
   ExpectError("classes:\n  - name: unknown\n  - name: unknown\n", "duplicate");
   ExpectError("classes:\n  - name: unknown\n    attributes: {predict_path: maybe}\n", "maybe");
   ExpectError("classes: [", "not valid YAML");
+  ExpectError("classes:\n  - name: unknown\n    prior: 0\n", "classes[0] (unknown).prior' = '0'");
+  ExpectError("classes:\n  - name: unknown\n    prior: 1.5\n", "need 0 < prior <= 1");
   EXPECT_THROW(Atlas::Load("/nonexistent/atlas.yaml"), romo::Error);
 }
 

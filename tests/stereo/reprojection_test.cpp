@@ -56,6 +56,54 @@ TEST(ReprojectionTest, FrontoParallelPlaneWithinSigmaZ) { ExpectPlaneWithinSigma
 
 TEST(ReprojectionTest, TiltedPlaneWithinSigmaZ) { ExpectPlaneWithinSigma({0.5, 0.2, 0.84}, 5.0); }
 
+// A box 2 m away in front of a wall 4 m away, its outline smeared by the matcher over two
+// columns (intermediate disparities that would float between the two), and a floor slanting
+// away: with max_disparity_spread the smeared columns and the pixels beside them go, the box,
+// the wall and the slanted floor stay.
+TEST(ReprojectionTest, OutlinePixelsBetweenNearAndFarAreDropped) {
+  constexpr int kW = 60, kH = 40, kScale = 16;
+  const RectifiedGeometry g = Geometry(kW, kH);
+  const double bf = g.focal_px * g.baseline_m;  // 100 px m
+  cv::Mat d(kH, kW, CV_16SC1);
+  for (int v = 0; v < kH; ++v) {
+    for (int u = 0; u < kW; ++u) {
+      double disparity = bf / 4.0;                     // wall, 25 px
+      if (u >= 20 && u < 40) disparity = bf / 2.0;     // box, 50 px
+      if (u == 18 || u == 41) disparity = bf / 3.2;    // smeared outline, 31.25 px
+      if (u == 19 || u == 40) disparity = bf / 2.6;    // 38.5 px
+      if (v >= 30) disparity = 20.0 + 0.5 * (v - 30);  // floor: 0.5 px a row (2.5 % a pixel)
+      d.at<short>(v, u) = static_cast<short>(std::lround(disparity * kScale));
+    }
+  }
+  ReprojectionParams params;
+  const PointCloud all = ReprojectDisparity(d, kScale, -1, cv::Mat(), g, params);
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(kW * kH));
+  params.max_disparity_spread = 0.05;
+  params.min_outline_step_px = 0.0;
+  const PointCloud kept = ReprojectDisparity(d, kScale, -1, cv::Mat(), g, params);
+  int floating = 0, box = 0, floor = 0;
+  for (Eigen::Index i = 0; i < kept.xyz.cols(); ++i) {
+    const double z = kept.xyz(2, i);
+    const long row = std::lround(kept.xyz(1, i) * g.focal_px / z + g.cy_px);
+    if (row >= 30) {
+      ++floor;
+    } else if (std::abs(z - 2.0) < 1e-3) {
+      ++box;
+    } else if (std::abs(z - 4.0) > 1e-3) {
+      ++floating;  // neither box nor wall
+    }
+  }
+  EXPECT_EQ(floating, 0);
+  // The box's 20 columns less the outermost one on each side (next to the smear), rows 0-28
+  // (row 29 touches the floor's row 30).
+  EXPECT_EQ(box, 18 * 29);
+  // The slanting floor (0.5 px a row, under 5 % of its disparity) keeps every row but the one
+  // next to the box and wall above it.
+  EXPECT_EQ(floor, kW * 9);
+  // Off by default.
+  EXPECT_EQ(ReprojectionParams{}.max_disparity_spread, 0.0);
+}
+
 // Against OpenCV's reprojectImageTo3D with the rectifier's Q (the reference) on an odd size.
 TEST(ReprojectionTest, MatchesOpenCvReprojectImageTo3D) {
   const Rectifier rect(testing::MakeRig(0, 161, 97));
@@ -113,6 +161,9 @@ TEST(ReprojectionTest, RejectsBadInput) {
   ReprojectionParams bad;
   bad.max_range_m = 0.0;
   EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(), g, bad), Error);
+  ReprojectionParams negative_spread;
+  negative_spread.max_disparity_spread = -0.1;
+  EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(), g, negative_spread), Error);
   RectifiedGeometry no_baseline = g;
   no_baseline.baseline_m = 0.0;
   EXPECT_THROW(ReprojectDisparity(cv::Mat(3, 5, CV_16SC1), 16, -16, cv::Mat(), no_baseline, {}), Error);

@@ -126,6 +126,8 @@ class Pipeline::Impl {
     stereo::StereoParams sp;
     sp.disparity_size = p.disparity_size;
     sp.reprojection.max_range_m = p.max_range_m;
+    sp.reprojection.max_disparity_spread = p.max_disparity_spread;
+    sp.reprojection.min_outline_step_px = p.min_outline_step_px;
     sp.sgm = p.sgm;
     return sp;
   }

@@ -26,6 +26,9 @@ struct ObjectClass {
   SizePrior length;         ///< footprint, length >= width
   SizePrior width;
   SizePrior height;
+  /// Relative frequency in the deployment's surroundings, (0, 1]: between classes whose sizes
+  /// explain a box about equally, the commoner one wins.
+  double prior = 1.0;
   bool movable = true;
   bool predict_path = false;
   double max_speed_mps = 30.0;

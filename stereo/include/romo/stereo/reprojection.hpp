@@ -15,6 +15,15 @@ struct ReprojectionParams {
   double sigma_d_px = 0.25;
   /// Points farther than this from the rig origin are dropped, m.
   double max_range_m = 40.0;
+  /// Pixels whose 3x3 neighbourhood's valid disparities span more than this fraction of their
+  /// own, and more than min_outline_step_px, are dropped (0 keeps all). Matching windows smear
+  /// disparity across an object's outline, and those in-between points would bridge objects that
+  /// stand close behind one another; a surface is only cut where it is seen within a few degrees
+  /// of grazing.
+  double max_disparity_spread = 0.0;
+  /// The floor under that spread, px: far away a fraction of the disparity is within the
+  /// matcher's noise (3x3 of sigma_d spans about 3 sigma_d).
+  double min_outline_step_px = 1.0;
   /// @throws romo::Error naming the field and value.
   void Validate() const;
 };
