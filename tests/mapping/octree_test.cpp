@@ -86,7 +86,8 @@ TEST(OctreeTest, DepthFirstTraversalVisitsEveryNodeOnceParentsFirst) {
 TEST(OctreeTest, BadInputGivesErrorsOrEmptyTrees) {
   EXPECT_THROW(VoxelOctree(0.f), romo::Error);
   EXPECT_THROW(VoxelOctree(-0.1f), romo::Error);
-  EXPECT_THROW(VoxelOctree(std::numeric_limits<float>::quiet_NaN()), romo::Error);
+  // Braces: VoxelOctree(std::numeric_limits<float>::quiet_NaN()) alone is a declaration to clang.
+  EXPECT_THROW(VoxelOctree{std::numeric_limits<float>::quiet_NaN()}, romo::Error);
   VoxelOctree tree(0.1f);
   tree.Build(Eigen::Matrix3Xf(3, 0));
   EXPECT_EQ(tree.leaf_count(), 0u);
