@@ -87,10 +87,24 @@ TEST(EgoMotionTest, RecoversCameraMotionDespiteMismatchesAndAMovedObject) {
   ASSERT_TRUE(obj.has_value());
   const Eigen::Isometry3d expected = T_ego * T_obj;  // object points: frame k -> frame k+1
   const Eigen::Isometry3d e = expected.inverse() * obj->T_2_1;
-  // 40 points spread over 20 cm: a coarser but still centimetre-level estimate.
+  // 40 points spread over 20 cm: a coarser but still centimetre-level estimate. The translation
+  // error is taken where the object is (its centroid): at the camera origin it also carries the
+  // rotation error times the lever arm, which flips with the last bits of the arithmetic (gcc
+  // -O2 vs clang -O1 gave 0.6 vs 2.9 cm there; 0.16 cm at the centroid with gcc).
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  int object_points = 0;
+  for (std::size_t i = 0; i < s.object_k.size(); ++i) {
+    if (!s.object_k[i]) continue;
+    centroid += s.m.p1.col(static_cast<Eigen::Index>(i));
+    ++object_points;
+  }
+  ASSERT_GT(object_points, 0);
+  centroid /= object_points;
   constexpr double kMaxObjTransErrM = 0.02;
   constexpr double kMaxObjRotErrRad = 0.05;
-  EXPECT_LT(e.translation().norm(), kMaxObjTransErrM);
+  std::printf("object motion error: %.4f m at its centroid, %.4f m at the origin, %.4f rad\n",
+              (e * centroid - centroid).norm(), e.translation().norm(), Eigen::AngleAxisd(e.linear()).angle());
+  EXPECT_LT((e * centroid - centroid).norm(), kMaxObjTransErrM);
   EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), kMaxObjRotErrRad);
 }
 
