@@ -52,7 +52,12 @@ std::string NodeText(const YAML::Node& node) {
 void RejectUnknownKeys(const YAML::Node& map, const std::set<std::string>& known,
                        const std::string& origin, const std::string& where) {
   for (const auto& item : map) {
-    const std::string key = item.first.as<std::string>();
+    // A YAML complex key ("? ...") is a map or list: yaml-cpp's as<string> would throw BadConversion.
+    if (!item.first.IsScalar()) {
+      FieldError(origin, where.empty() ? "(key)" : where + ".(key)", NodeText(item.first),
+                 "a key must be plain text");
+    }
+    const std::string key = item.first.Scalar();
     if (known.count(key) == 0) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;

@@ -133,6 +133,8 @@ TEST(RigConfigTest, EachBadValueNamesFieldAndValue) {
               {"rigs[1].left", "exactly one"});
   ExpectError(Replace(good, "    left: {address: 10.0.0.7}\n", ""), {"rigs[1].left", "missing"});
   ExpectError(Replace(good, "exposure_us: 8000", "exposure: 8000"), {"rigs[0].exposure", "unknown field"});
+  // A complex key (found by fuzz_rig_yaml: it escaped as yaml-cpp's BadConversion).
+  ExpectError(Replace(good, "exposure_us: 8000", "? [a, b]\n    : 8000"), {"rigs[0].(key)", "plain text"});
   ExpectError(Replace(good, "discovery_timeout_s: 3", "discovery_timeout_s: 0"), {"discovery_timeout_s", "0"});
 }
 
