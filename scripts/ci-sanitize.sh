@@ -8,11 +8,13 @@
 #   ROMO_ASAN_BUILD_DIR   build directory (default build-asan-clang)
 #   ROMO_ASAN_CTEST_ARGS  ctest selection (default "-L unit": CI's ~30 min cannot hold a second full
 #                         suite on 2 cores after test.sh; set it empty for the whole suite)
-#   ROMO_FUZZ_SECONDS     seconds per fuzz target (default 10; 0 skips the smoke)
+#   ROMO_FUZZ_RUNS        inputs per fuzz target for the smoke (default 5000, from seed 1: a smoke
+#                         that passes once passes again; 0 skips it). Open-ended fuzzing that finds
+#                         new crashes is scripts/fuzz.sh --seconds N.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${ROMO_ASAN_BUILD_DIR:-build-asan-clang}
-fuzz_seconds=${ROMO_FUZZ_SECONDS:-10}
+fuzz_runs=${ROMO_FUZZ_RUNS:-5000}
 # shellcheck source=sanitizers/env.sh
 source scripts/sanitizers/env.sh
 
@@ -27,8 +29,8 @@ t1=$(date +%s)
 # shellcheck disable=SC2086  # ROMO_ASAN_CTEST_ARGS is a list of arguments
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" ${ROMO_ASAN_CTEST_ARGS--L unit}
 t2=$(date +%s)
-if [ "$fuzz_seconds" -gt 0 ]; then
-  ./scripts/fuzz.sh --build-dir "$build_dir" --no-build --seconds "$fuzz_seconds"
+if [ "$fuzz_runs" -gt 0 ]; then
+  ./scripts/fuzz.sh --build-dir "$build_dir" --no-build --runs "$fuzz_runs" --seed 1
 fi
 t3=$(date +%s)
 echo "ci-sanitize: build $((t1 - t0)) s, tests $((t2 - t1)) s, fuzz smoke $((t3 - t2)) s"

@@ -6,6 +6,8 @@
 #   scripts/fuzz.sh --seconds 600        # the longer run (10 min per target)
 #   scripts/fuzz.sh --seconds 60 pcd recording
 #   scripts/fuzz.sh --build-dir build-asan-clang --no-build   # reuse an existing fuzz build
+#   scripts/fuzz.sh --runs 5000 --seed 1   # CI's smoke: a fixed number of inputs from a fixed
+#                                          # seed, so a run is repeatable on any machine
 #
 # Targets are fuzz/fuzz_<name>.cpp; seeds come from fuzz/corpus/<name>/ (read only), inputs
 # libFuzzer finds interesting go to <build>/fuzz-work/<name>/corpus/, crashing inputs to
@@ -16,12 +18,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=10
+runs=0
+seed=0
 build_dir=${ROMO_FUZZ_BUILD_DIR:-build-fuzz}
 build=1
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=$2; shift 2 ;;
+    --runs) runs=$2; shift 2 ;;
+    --seed) seed=$2; shift 2 ;;
     --build-dir) build_dir=$2; shift 2 ;;
     --no-build) build=0; shift ;;
     -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
@@ -53,8 +59,14 @@ fi
 
 # Limits: 2 GB resident, and no single allocation above 512 MB: every seed is a few KB, so a
 # parser asking for more than that is trusting a size field it should have checked.
-fuzz_args=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=512
-           -print_final_stats=1 -max_len=65536)
+fuzz_args=(-timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 -max_len=65536)
+if [ "$runs" -gt 0 ]; then
+  # Repeatable: with a fixed seed and input count, and the work corpus starting empty (a clean
+  # clone), libFuzzer mutates the same inputs on any machine.
+  fuzz_args+=(-runs="$runs" -seed="$seed")
+else
+  fuzz_args+=(-max_total_time="$seconds")
+fi
 summary=()
 failed=0
 for t in "${targets[@]}"; do
@@ -64,7 +76,7 @@ for t in "${targets[@]}"; do
   find "$work" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'oom-*' -o -name 'timeout-*' -o -name 'leak-*' \) \
     -exec mv -t "$work/earlier" {} +
   log="$work/fuzz.log"
-  echo "== fuzz_$t: ${seconds} s"
+  if [ "$runs" -gt 0 ]; then echo "== fuzz_$t: $runs inputs, seed $seed"; else echo "== fuzz_$t: ${seconds} s"; fi
   rc=0
   "$build_dir/fuzz/fuzz_$t" "${fuzz_args[@]}" -artifact_prefix="$work/" \
     "$work/corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
@@ -79,6 +91,10 @@ for t in "${targets[@]}"; do
   echo "   $line"
   summary+=("$line")
 done
-echo "== fuzz summary (${seconds} s per target, build $build_dir)"
+if [ "$runs" -gt 0 ]; then
+  echo "== fuzz summary ($runs inputs from seed $seed per target, build $build_dir)"
+else
+  echo "== fuzz summary (${seconds} s per target, build $build_dir)"
+fi
 printf '   %s\n' "${summary[@]}"
 exit "$failed"

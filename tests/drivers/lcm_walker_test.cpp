@@ -36,6 +36,13 @@ TEST(LcmWalkerTest, NegativeCountsZeroStringsAndTruncationFail) {
   EXPECT_FALSE(short_input.Skip(5));
   EXPECT_EQ(short_input.Reason("t"), "t: truncated (4 bytes)");
   EXPECT_FALSE(LcmWalker(nullptr, 100).Skip(1));
+  // "a\0b" with its terminator: LCM would encode it back as "a" (found by fuzz_lcm_planning).
+  const std::vector<std::uint8_t> nul_inside = {0, 0, 0, 4, 'a', 0, 'b', 0};
+  LcmWalker with_nul(nul_inside.data(), nul_inside.size());
+  EXPECT_FALSE(with_nul.String("name"));
+  EXPECT_EQ(with_nul.Reason("t"), "t.name: NUL at byte 1 inside the text");
+  const std::vector<std::uint8_t> plain = {0, 0, 0, 3, 'a', 'b', 0};
+  EXPECT_TRUE(LcmWalker(plain.data(), plain.size()).String("name"));
 }
 
 TEST(LcmWalkerTest, StereoFrameWithAnImpossibleImageSizeIsDroppedWithItsReason) {

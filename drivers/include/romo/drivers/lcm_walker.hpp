@@ -44,6 +44,16 @@ class LcmWalker {
       bad_field_ = field;
       return ok_ = false;
     }
+    // A NUL inside the text: the decoded std::string would keep it, but LCM encodes strings up
+    // to their first NUL, so the message would not encode back to its own size.
+    for (std::int32_t i = 0; i + 1 < length; ++i) {
+      if (bytes_[pos_ + static_cast<std::size_t>(i)] == 0) {
+        bad_field_ = field;
+        bad_value_ = i;
+        embedded_nul_ = true;
+        return ok_ = false;
+      }
+    }
     return Skip(static_cast<std::size_t>(length));
   }
   /// Counts of elements of @p bytes_each fixed bytes: the count, then skips the elements.
@@ -55,6 +65,9 @@ class LcmWalker {
   bool ok() const { return ok_; }
   /// Why the walk failed, naming @p type: the field and its count, or truncation.
   std::string Reason(const std::string& type) const {
+    if (embedded_nul_) {
+      return type + "." + bad_field_ + ": NUL at byte " + std::to_string(bad_value_) + " inside the text";
+    }
     if (bad_field_ != nullptr) {
       return type + "." + bad_field_ + " = " + std::to_string(bad_value_) + " does not fit a " +
              std::to_string(size_) + "-byte message";
@@ -69,6 +82,7 @@ class LcmWalker {
   bool ok_ = true;
   const char* bad_field_ = nullptr;
   std::int32_t bad_value_ = 0;
+  bool embedded_nul_ = false;
 };
 
 /// True when @p data starts with the 8-byte LCM type hash @p hash (big-endian).
