@@ -64,6 +64,11 @@ TrajectorySet ReadEthUcy(const std::string& path, bool strict) {
       problem(&set.skipped_malformed, "pedestrian id is not an integer ('" + tok[1] + "')");
       continue;
     }
+    // Converting a double beyond long's range is undefined (found by fuzz_eth_ucy: 3.4e39).
+    if (std::abs(v[1]) > 1e15) {
+      problem(&set.skipped_malformed, "pedestrian id out of range ('" + tok[1] + "')");
+      continue;
+    }
     set.tracks[static_cast<long>(v[1])].push_back({v[0], Eigen::Vector2d(v[2], v[3])});
   }
   if (in.bad()) Fail("trajectory file '" + path + "': read error");

@@ -67,9 +67,10 @@ TEST(TrajectoryEvalTest, BadRowsAreSkippedCountedAndReported) {
   text += "50\t3\t1.0\t2.0\n";              // pedestrian 3 seen once
   text += "60\t4.5\t1.0\t2.0\n";            // non-integer id
   text += "70\t5\t1.0\n";                   // 3 fields
+  text += "80\t3e39\t1.0\t2.0\n";            // id beyond any integer type (fuzz_eth_ucy)
   test::WriteFile(path, text);
   const TrajectorySet set = ReadEthUcy(path);
-  EXPECT_EQ(set.skipped_malformed, 3);
+  EXPECT_EQ(set.skipped_malformed, 4);
   EXPECT_EQ(set.skipped_duplicate, 1);
   EXPECT_EQ(set.skipped_nonfinite, 1);
   EXPECT_EQ(set.pedestrians_seen_once, 1);
