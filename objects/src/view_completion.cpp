@@ -95,14 +95,15 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
     }
   }
   if (truncated_axis >= 0 && best_class >= 0) {
-    auto completed_extent = [&](const Candidate& k) {
-      const ObjectClass& cls = atlas.classes()[static_cast<std::size_t>(k.class_index)];
-      return k.length_axis == truncated_axis ? cls.length.mean_m : cls.width.mean_m;
+    auto completed_extent = [&](int class_index, int length_axis) {
+      const ObjectClass& cls = atlas.classes()[static_cast<std::size_t>(class_index)];
+      return length_axis == truncated_axis ? cls.length.mean_m : cls.width.mean_m;
     };
-    double least = completed_extent({0.0, best_class, best_length_axis, best_weight});
+    double least = completed_extent(best_class, best_length_axis);
     for (const Candidate& k : candidates) {
-      if (k.weight * params.ambiguity_ratio >= best_weight && completed_extent(k) < least) {
-        least = completed_extent(k);
+      const double completed = completed_extent(k.class_index, k.length_axis);
+      if (k.weight * params.ambiguity_ratio >= best_weight && completed < least) {
+        least = completed;
         best_class = k.class_index;
         best_length_axis = k.length_axis;
       }

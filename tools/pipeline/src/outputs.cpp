@@ -52,6 +52,12 @@ class OutputSink::Impl {
   std::int64_t frames_with_feasible_slot = 0;
   std::int64_t dropped = 0, malformed = 0;
 
+  // One output message into the log and onto the bus (each when open).
+  void Emit(const std::string& channel, std::int64_t stamp_ns, const std::vector<std::uint8_t>& bytes) {
+    if (log) log->WriteRaw(channel, stamp_ns, bytes.data(), bytes.size());
+    if (bus) bus->Publish(channel, bytes);
+  }
+
   void RecordStatus(const pi::PerceptionStatus& status) {
     for (const auto& e : status.events) {
       if (events.size() < 200) events.push_back("frame " + std::to_string(status.frame_sequence) + ": " + e);
@@ -105,11 +111,8 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
     for (const auto& e : passthrough) {
       s.log->WriteRaw(e.channel, r.stamp_ns, e.data.data(), e.data.size());
     }
-    for (const auto& [channel, bytes] : messages) s.log->WriteRaw(channel, r.stamp_ns, bytes.data(), bytes.size());
   }
-  if (s.bus) {
-    for (const auto& [channel, bytes] : messages) s.bus->Publish(channel, bytes);
-  }
+  for (const auto& [channel, bytes] : messages) s.Emit(channel, r.stamp_ns, bytes);
   if (s.csv) s.csv->WriteFrame(r.predictions);
   if (!s.options.out_dir.empty() && s.options.frame_pictures) {
     char name[64];
@@ -151,9 +154,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
 
 void OutputSink::WriteStatus(const pi::PerceptionStatus& status) {
   Impl& s = *impl_;
-  const std::vector<std::uint8_t> bytes = pi::Encode(status);
-  if (s.log) s.log->WriteRaw(pi::kPerceptionStatusChannel, status.stamp_ns, bytes.data(), bytes.size());
-  if (s.bus) s.bus->Publish(pi::kPerceptionStatusChannel, bytes);
+  s.Emit(pi::kPerceptionStatusChannel, status.stamp_ns, pi::Encode(status));
   s.RecordStatus(status);
 }
 
