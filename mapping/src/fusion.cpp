@@ -42,7 +42,7 @@ Eigen::Isometry3f VehicleDisplacement(const VehicleMotion& motion, std::int64_t 
 }
 
 PointCloud FuseRigClouds(const std::vector<RigCloud>& rigs, const VehicleMotion& motion,
-                         const FusionParams& params, FusionStats* stats) {
+                         const FusionParams& params, FusionStats* stats, std::vector<int>* point_rig_ids) {
   params.Validate();
   if (!std::isfinite(motion.speed_mps) || !std::isfinite(motion.yaw_rate_radps)) {
     std::ostringstream msg;
@@ -132,12 +132,18 @@ PointCloud FuseRigClouds(const std::vector<RigCloud>& rigs, const VehicleMotion&
       fused.xyz.col(m) = fused.xyz.col(i);
       fused.sigma_z_m[m] = fused.sigma_z_m[i];
       fused.intensity[m] = fused.intensity[i];
+      rig_of_point[m] = rig_of_point[i];
       ++m;
     }
     local.thinned = static_cast<std::size_t>(n - m);
     fused.Resize(static_cast<std::size_t>(m));
+    rig_of_point.resize(static_cast<std::size_t>(m));
   }
   if (stats) *stats = local;
+  if (point_rig_ids) {
+    point_rig_ids->resize(rig_of_point.size());
+    for (std::size_t i = 0; i < rig_of_point.size(); ++i) (*point_rig_ids)[i] = rigs[rig_of_point[i]].rig_id;
+  }
   return fused;
 }
 

@@ -23,10 +23,9 @@ double ExtentCost(const SizePrior& prior, double x, bool truncated) {
   return z * z;
 }
 
-}  // namespace
-
-ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
-                                const ViewCompletionParams& params, double depth_spread_m) {
+// Every class with priors competes when @p only_class < 0, else only that one.
+ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
+                   const ViewCompletionParams& params, double depth_spread_m, int only_class) {
   if (!(depth_spread_m >= 0.0) || !std::isfinite(depth_spread_m)) {
     Fail("ClassifyFromViewpoint: depth_spread_m must be finite and >= 0, got " + std::to_string(depth_spread_m));
   }
@@ -75,7 +74,7 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
   int best_class = -1, best_length_axis = 0;
   for (std::size_t c = 0; c < atlas.classes().size(); ++c) {
     const ObjectClass& cls = atlas.classes()[c];
-    if (!cls.has_priors) continue;
+    if (!cls.has_priors || (only_class >= 0 && static_cast<int>(c) != only_class)) continue;
     const double h = ExtentCost(cls.height, box.size.z(), false);
     if (h < 0) continue;
     for (int length_axis = 0; length_axis < 2; ++length_axis) {
@@ -144,6 +143,22 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
     out.box.axes.col(1) = width_dir;
   }
   return out;
+}
+
+}  // namespace
+
+ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
+                                const ViewCompletionParams& params, double depth_spread_m) {
+  return Classify(atlas, box, viewer_xy, params, depth_spread_m, -1);
+}
+
+ViewedBox CompleteAsClass(const Atlas& atlas, int class_index, const Box3& box, const Eigen::Vector2f& viewer_xy,
+                          const ViewCompletionParams& params, double depth_spread_m) {
+  if (class_index < 0 || class_index >= static_cast<int>(atlas.classes().size())) {
+    Fail("CompleteAsClass: class index " + std::to_string(class_index) + " is not in the atlas (" +
+         std::to_string(atlas.classes().size()) + " classes)");
+  }
+  return Classify(atlas, box, viewer_xy, params, depth_spread_m, class_index);
 }
 
 }  // namespace romo::objects

@@ -95,6 +95,44 @@ inline int IndexOf(const std::vector<std::pair<Image, Image>>& frames, const Ima
   return -1;
 }
 
+/// Why @p image is none of the served frames: its size, whether it is all zero (the emulator's
+/// answer to a client that changed size or format), and which served frame each band of rows
+/// shows (rows from two frames mean GVSP packets of different frames were assembled together).
+inline std::string DescribeUnserved(const std::vector<std::pair<Image, Image>>& frames, const Image& image,
+                                    bool left) {
+  std::string out = std::to_string(image.width) + "x" + std::to_string(image.height);
+  const std::size_t row = static_cast<std::size_t>(image.width) * drivers::BytesPerPixel(image.format);
+  bool zero = true;
+  for (int y = 0; y < image.height && zero; ++y) {
+    for (std::size_t x = 0; x < row; ++x) zero &= image.row(y)[x] == 0;
+  }
+  out += zero ? ", all zero" : "";
+  std::string bands;
+  int band_start = 0, band_index = -2;
+  auto flush = [&](int end) {
+    if (band_index == -2) return;
+    bands += " rows " + std::to_string(band_start) + "-" + std::to_string(end - 1) + ": " +
+             (band_index < 0 ? std::string("none") : "frame " + std::to_string(band_index)) + ";";
+  };
+  for (int y = 0; y < image.height; ++y) {
+    int match = -1;
+    for (std::size_t k = 0; k < frames.size() && match < 0; ++k) {
+      const Image& served = left ? frames[k].first : frames[k].second;
+      if (served.width == image.width && served.format == image.format && y < served.height &&
+          std::memcmp(served.row(y), image.row(y), row) == 0) {
+        match = static_cast<int>(k);
+      }
+    }
+    if (match != band_index) {
+      flush(y);
+      band_start = y;
+      band_index = match;
+    }
+  }
+  flush(image.height);
+  return out + ";" + bands;
+}
+
 struct Check {
   int sets = 0;
   int complete_sets = 0;      // every rig present
@@ -121,8 +159,13 @@ inline Check CheckRecorded(const std::string& path, const Served& served) {
       const auto& frames = served.frames[stereo.rig_id];
       const int left = IndexOf(frames, stereo.left.image, true);
       const int right = IndexOf(frames, stereo.right.image, false);
-      EXPECT_GE(left, 0) << "rig " << stereo.rig_id << " left image of set " << check.sets << " was never served";
-      EXPECT_EQ(left, right) << "rig " << stereo.rig_id << " paired images of different instants";
+      EXPECT_GE(left, 0) << "rig " << stereo.rig_id << " left image of set " << check.sets
+                         << " was never served: " << DescribeUnserved(frames, stereo.left.image, true);
+      EXPECT_EQ(left, right) << "rig " << stereo.rig_id << " paired images of different instants (set "
+                             << check.sets << ", stamp " << stereo.left.stamp_ns << ", sequence "
+                             << stereo.left.sequence << "/" << stereo.right.sequence << ")"
+                             << (right < 0 ? "; right never served: " + DescribeUnserved(frames, stereo.right.image, false)
+                                           : std::string());
       if (index < 0) index = left;
       EXPECT_EQ(left, index) << "rigs of one frame set show different instants";
       EXPECT_EQ(stereo.left.stamp_ns, stereo.right.stamp_ns);

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -48,8 +49,10 @@ TEST(FusionTest, MotionCompensationPutsAStaticPointWhereItWasAtTheReferenceInsta
   rear.cloud = Observe(pts.rightCols(1), rear.T_vehicle_rig, VehicleDisplacement(motion, rear.stamp_ns), 0.01f);
   FusionParams params;
   params.overlap_voxel_m = 0.f;
-  const PointCloud fused = FuseRigClouds({front, rear}, motion, params);
+  std::vector<int> rig_ids;
+  const PointCloud fused = FuseRigClouds({front, rear}, motion, params, nullptr, &rig_ids);
   ASSERT_EQ(fused.size(), 2u);
+  EXPECT_EQ(rig_ids, (std::vector<int>{0, 3}));  // which rig saw each point (its viewpoint)
   constexpr float kPositionToleranceM = 1e-4f;  // float rounding over ~10 m
   EXPECT_LT((fused.xyz.col(0) - pts.col(0)).norm(), kPositionToleranceM);
   EXPECT_LT((fused.xyz.col(1) - pts.col(1)).norm(), kPositionToleranceM);
@@ -84,9 +87,11 @@ TEST(FusionTest, OverlapSeenByTwoRigsIsCountedOnceKeepingTheLowerSigma) {
   FusionParams params;
   params.overlap_voxel_m = 0.05f;
   FusionStats stats;
-  const PointCloud fused = FuseRigClouds({front, right}, still, params, &stats);
+  std::vector<int> rig_ids;
+  const PointCloud fused = FuseRigClouds({front, right}, still, params, &stats, &rig_ids);
   EXPECT_EQ(stats.input_points, 900u);
   EXPECT_EQ(fused.size(), 500u);  // the right rig's 400 duplicates are gone
+  EXPECT_EQ(rig_ids, std::vector<int>(500, 0));  // every kept point is the front rig's
   EXPECT_EQ(stats.thinned, 400u);
   for (float s : fused.sigma_z_m) EXPECT_FLOAT_EQ(s, 0.02f);
 }

@@ -89,6 +89,43 @@ TEST(ViewCompletionTest, CornerViewsAndImplausibleBoxesAreNotCompleted) {
   EXPECT_TRUE(w.box.center.isApprox(wall.center));
 }
 
+TEST(ViewCompletionTest, ViewpointDecidesWhichFaceWasSeen) {
+  const Atlas atlas = Load();
+  // The front 0.5 m of a car, 1.8 m across, at (3, 3): from the vehicle origin the line of sight
+  // is at 45 degrees to both axes (no face is truncated, and 0.5 m is too narrow for anything
+  // car-like); from a corner camera at (3, 0) it runs straight along the box's x axis.
+  const Box3 seen = MakeBox({3.f, 3.25f}, 1.8f, 0.5f, 1.5f, 0.f);
+  EXPECT_FALSE(ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f::Zero()).completed);
+  const ViewedBox v = ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f(3.f, 0.f));
+  EXPECT_EQ(NameOf(atlas, v.classification), "car");
+  ASSERT_TRUE(v.completed);
+  const double car_length = atlas.classes()[atlas.Require("car")].length.mean_m;
+  EXPECT_NEAR(v.box.center.y(), 3.0 + car_length / 2, 1e-5);  // the near face (y = 3) kept
+}
+
+TEST(ViewCompletionTest, CompletingAsAKnownClassKeepsTheNearFaceOrSaysUnknown) {
+  const Atlas atlas = Load();
+  const int car = atlas.Require("car");
+  const double car_length = atlas.classes()[static_cast<std::size_t>(car)].length.mean_m;
+  // A car's front, 1.5 m across (its side cut by the image border), 0.4 m deep, 1.4 m tall, whose
+  // track has been a car: completed along the line of sight to a car's length.
+  const Box3 front = MakeBox({9.2f, 0.f}, 1.5f, 0.4f, 1.4f, kPi / 2);
+  const ViewedBox as_car = CompleteAsClass(atlas, car, front, Eigen::Vector2f::Zero());
+  EXPECT_EQ(as_car.classification.class_index, car);
+  ASSERT_TRUE(as_car.completed);
+  EXPECT_NEAR(as_car.box.size.x(), car_length, 1e-5);
+  EXPECT_NEAR(as_car.box.center.x(), 9.0 + car_length / 2, 1e-5);
+  EXPECT_GE(as_car.classification.score, atlas.min_score());
+  // A fragment 0.6 m tall cannot be any part of a car standing on the ground: unknown, unchanged.
+  const Box3 fragment = MakeBox({7.f, 1.f}, 0.6f, 0.1f, 0.6f, 0.f);
+  const ViewedBox f = CompleteAsClass(atlas, car, fragment, Eigen::Vector2f::Zero());
+  EXPECT_EQ(f.classification.class_index, atlas.unknown_index());
+  EXPECT_FALSE(f.completed);
+  EXPECT_TRUE(f.box.center.isApprox(fragment.center));
+  EXPECT_THROW(CompleteAsClass(atlas, 99, front, Eigen::Vector2f::Zero()), romo::Error);
+  EXPECT_THROW(CompleteAsClass(atlas, -1, front, Eigen::Vector2f::Zero()), romo::Error);
+}
+
 TEST(ViewCompletionTest, NonFiniteInputIsAnError) {
   const Atlas atlas = Load();
   Box3 b = MakeBox({5.f, 0.f}, 1.f, 1.f, 1.f, 0.f);

@@ -49,6 +49,24 @@ double DepthSpread(const std::vector<float>& sigma_z_m, const std::vector<int>& 
   return 2.0 * lo * sigmas[sigmas.size() / 2];
 }
 
+// Where a blob was seen from: the camera of the rig that delivered most of its points. Close to
+// the vehicle the line of sight from the vehicle's origin is metres off the cameras' (rigs sit at
+// its corners and sides), and it decides which face of the box was seen.
+Eigen::Vector2f BlobViewer(const std::vector<int>& blob, const std::vector<int>& point_rig_ids,
+                           const drivers::Calibration& calibration) {
+  std::map<int, int> count;
+  for (int i : blob) ++count[point_rig_ids[static_cast<std::size_t>(i)]];
+  int rig = -1, most = 0;
+  for (const auto& [id, n] : count) {
+    if (n > most) {
+      most = n;
+      rig = id;
+    }
+  }
+  if (rig < 0) return Eigen::Vector2f::Zero();
+  return calibration.rig(rig).T_vehicle_rig.translation().head<2>().cast<float>();
+}
+
 }  // namespace
 
 mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
@@ -295,7 +313,8 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     motion.speed_mps = static_cast<float>(vehicle->speed_mps);
     motion.yaw_rate_radps = static_cast<float>(vehicle->yaw_rate_radps);
   }
-  r.cloud = mapping::FuseRigClouds(inputs, motion, s.params.fusion);
+  std::vector<int> point_rig_ids;
+  r.cloud = mapping::FuseRigClouds(inputs, motion, s.params.fusion, nullptr, &point_rig_ids);
   r.status.stages.push_back({"fusion", MsSince(t0)});
 
   // Stage: ground removal.
@@ -332,20 +351,30 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // it (stereo mismatches, overhangs) stays an obstacle of unknown class.
   t0 = Clock::now();
   std::vector<objects::Detection> detections;
+  const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
+  std::vector<double> depth_spreads(r.boxes.size(), 0.0);
+  std::vector<bool> on_ground(r.boxes.size(), false);
+  std::vector<Eigen::Vector2f> viewers(r.boxes.size(), Eigen::Vector2f::Zero());
+  auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {
+    objects::Detection d = objects::Detection::FromBox(box, cls);
+    d.xy_m = (r.T_world_vehicle * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
+    d.yaw_rad += r.ego_world.yaw_rad;
+    return d;
+  };
   for (std::size_t box_index = 0; box_index < r.boxes.size(); ++box_index) {
     objects::Box3& box = r.boxes[box_index];
     const float bottom_gap_m = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
     objects::Classification cls{s.atlas.unknown_index(), 1.0};
-    if (bottom_gap_m <= s.params.max_ground_gap_m) {
+    on_ground[box_index] = bottom_gap_m <= s.params.max_ground_gap_m;
+    if (on_ground[box_index]) {
+      depth_spreads[box_index] = DepthSpread(r.cloud.sigma_z_m, r.blobs[box_index], s.params.box_trim_fraction);
+      viewers[box_index] = BlobViewer(r.blobs[box_index], point_rig_ids, s.calibration);
       const objects::ViewedBox viewed = objects::ClassifyFromViewpoint(
-          s.atlas, box, Eigen::Vector2f::Zero(), s.params.completion,
-          DepthSpread(r.cloud.sigma_z_m, r.blobs[box_index], s.params.box_trim_fraction));
+          s.atlas, box, viewers[box_index], s.params.completion, depth_spreads[box_index]);
       cls = viewed.classification;
       box = viewed.box;
     }
-    objects::Detection d = objects::Detection::FromBox(box, cls);
-    d.xy_m = (r.T_world_vehicle * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
-    d.yaw_rad += r.ego_world.yaw_rad;
+    const objects::Detection d = world_detection(box, cls);
     r.box_classes.push_back(s.atlas.classes()[d.classification.class_index].name);
     detections.push_back(d);
   }
@@ -355,6 +384,23 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   t0 = Clock::now();
   const double t_s = (stamp_ns - *s.first_stamp_ns) * 1e-9;
   r.tracks = s.tracker.Update(t_s, detections);
+  // A track's class, voted over every view of it, is steadier than one frame's: a car seen whole
+  // earlier and cut by the image border or seen end-on now is completed as a car, if its measured
+  // extents can be one (a fragment too low for a car stays unknown).
+  for (const objects::Track& tr : r.tracks) {
+    const int i = tr.detection_index;
+    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !on_ground[i]) continue;
+    if (tr.class_index < 0 || tr.class_index == s.atlas.unknown_index() ||
+        tr.class_index == detections[i].classification.class_index) {
+      continue;
+    }
+    const objects::ViewedBox viewed = objects::CompleteAsClass(s.atlas, tr.class_index, measured_boxes[i],
+                                                               viewers[i], s.params.completion, depth_spreads[i]);
+    if (viewed.classification.class_index != tr.class_index) continue;
+    r.boxes[i] = viewed.box;
+    r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].name;
+    detections[i] = world_detection(viewed.box, viewed.classification);
+  }
   r.status.stages.push_back({"tracks", MsSince(t0)});
 
   // Stage: pedestrian predictions in vehicle frame, local ENU and WGS84.

@@ -45,9 +45,11 @@ struct FusionStats {
 Eigen::Isometry3f VehicleDisplacement(const VehicleMotion& motion, std::int64_t stamp_ns);
 
 /// Fuses @p rigs into one vehicle-frame cloud at motion.reference_stamp_ns (non-finite points
-/// dropped). Points keep their sigma_z and intensity.
+/// dropped). Points keep their sigma_z and intensity; @p point_rig_ids, when given, receives the
+/// rig id each fused point came from (which camera saw it, e.g. to know the viewpoint).
 /// @throws romo::Error on invalid params, an inconsistent rig cloud or a stale stamp (names rig).
 PointCloud FuseRigClouds(const std::vector<RigCloud>& rigs, const VehicleMotion& motion,
-                         const FusionParams& params, FusionStats* stats = nullptr);
+                         const FusionParams& params, FusionStats* stats = nullptr,
+                         std::vector<int>* point_rig_ids = nullptr);
 
 }  // namespace romo::mapping

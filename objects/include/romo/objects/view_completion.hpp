@@ -39,4 +39,11 @@ struct ViewedBox {
 ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
                                 const ViewCompletionParams& params = {}, double depth_spread_m = 0.0);
 
+/// The same for a class already known (e.g. voted by the box's track over earlier, fuller views):
+/// the box is scored and completed as @p class_index only; it stays unknown when its extents
+/// cannot be that class (a fragment too low or too long for it).
+/// @throws romo::Error as above, or for a class index outside the atlas.
+ViewedBox CompleteAsClass(const Atlas& atlas, int class_index, const Box3& box, const Eigen::Vector2f& viewer_xy,
+                          const ViewCompletionParams& params = {}, double depth_spread_m = 0.0);
+
 }  // namespace romo::objects
