@@ -174,8 +174,11 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
   return box;
 }
 
-Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
-                    std::optional<float> hint_yaw_rad, float trim_fraction) {
+namespace {
+
+// FitVerticalBox, or with @p fixed_yaw_rad the rectangle along that heading (no search).
+Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
+                 std::optional<float> hint_yaw_rad, float trim_fraction, std::optional<float> fixed_yaw_rad) {
   CheckIndices(xyz, indices, "FitVerticalBox");
   if (!(up.allFinite() && std::abs(up.norm() - 1.f) < 1e-3f)) {
     std::ostringstream msg;
@@ -234,7 +237,9 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
       best_center = Point2(c * am - s * bm, s * am + c * bm);
     }
   };
-  if (trim_fraction > 0.f) {
+  if (fixed_yaw_rad) {
+    try_heading(*fixed_yaw_rad, footprint, trim_fraction);
+  } else if (trim_fraction > 0.f) {
     // Outliers make the exact hull's rectangle follow them; the trimmed rectangle does not. A
     // rectangle's heading repeats every 90 degrees.
     // The search runs on at most ~1000 points (evenly strided); the extents use all of them.
@@ -270,6 +275,55 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
   box.axes.col(1) = up.cross(heading);
   box.axes.col(2) = up;
   return box;
+}
+
+}  // namespace
+
+Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
+                    std::optional<float> hint_yaw_rad, float trim_fraction) {
+  return FitVertical(xyz, indices, up, hint_yaw_rad, trim_fraction, std::nullopt);
+}
+
+Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
+                             float yaw_rad, float trim_fraction) {
+  if (!std::isfinite(yaw_rad)) Fail("FitVerticalBoxAtHeading: yaw_rad must be finite, got " + std::to_string(yaw_rad));
+  return FitVertical(xyz, indices, up, yaw_rad, trim_fraction, yaw_rad);
+}
+
+std::optional<float> DenoisedHeading(const Eigen::Matrix3Xf& xyz, const std::vector<float>& sigma_z_m,
+                                     const std::vector<int>& indices, const Eigen::Vector2f& viewer_xy,
+                                     double noise_dominated_fraction) {
+  CheckIndices(xyz, indices, "DenoisedHeading");
+  if (sigma_z_m.size() != static_cast<std::size_t>(xyz.cols())) {
+    Fail("DenoisedHeading: " + std::to_string(sigma_z_m.size()) + " sigma_z values for " +
+         std::to_string(xyz.cols()) + " points");
+  }
+  if (!viewer_xy.allFinite() || !(noise_dominated_fraction >= 0.0)) {
+    Fail("DenoisedHeading: the viewer must be finite and noise_dominated_fraction >= 0, got " +
+         std::to_string(noise_dominated_fraction));
+  }
+  if (indices.size() < 3) return std::nullopt;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (int i : indices) mean += xyz.col(i).head<2>().cast<double>();
+  mean /= static_cast<double>(indices.size());
+  Eigen::Matrix2d points = Eigen::Matrix2d::Zero(), noise = Eigen::Matrix2d::Zero();
+  for (int i : indices) {
+    const Eigen::Vector2d p = xyz.col(i).head<2>().cast<double>();
+    points += (p - mean) * (p - mean).transpose();
+    const Eigen::Vector2d sight = p - viewer_xy.cast<double>();
+    if (sight.norm() < 1e-6) continue;
+    const double sigma = sigma_z_m[static_cast<std::size_t>(i)];
+    noise += sigma * sigma * sight.normalized() * sight.normalized().transpose();
+  }
+  points /= static_cast<double>(indices.size());
+  noise /= static_cast<double>(indices.size());
+  const Eigen::Vector2d sight = mean - viewer_xy.cast<double>();
+  if (sight.norm() < 1e-6) return std::nullopt;
+  const Eigen::Vector2d u = sight.normalized();
+  if (!(u.dot(noise * u) > noise_dominated_fraction * u.dot(points * u))) return std::nullopt;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> shape(points - noise);
+  const Eigen::Vector2d axis = shape.eigenvectors().col(1);  // eigenvalues ascend: the longest
+  return static_cast<float>(std::atan2(axis.y(), axis.x()));
 }
 
 }  // namespace romo::objects

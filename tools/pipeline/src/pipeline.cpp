@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -332,6 +333,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
 
   // Stage: boxes (vertical cuboids about the ground normal, heading hinted by the tracks).
   t0 = Clock::now();
+  std::vector<Eigen::Vector2f> viewers;  // per box: the camera that saw most of it
   const Eigen::Vector3f up = r.ground_plane.normal.normalized();
   for (auto& blob : seg.blobs) {
     const Eigen::Vector3f c = r.cloud.xyz(Eigen::all, blob).rowwise().mean();
@@ -341,8 +343,14 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     if (auto h = s.tracker.YawHint(c_world)) hint = static_cast<float>(*h - r.ego_world.yaw_rad);
     objects::Box3 box = objects::FitVerticalBox(r.cloud.xyz, blob, up, hint, s.params.box_trim_fraction);
     if (box.size.z() < s.params.min_object_height_m) continue;
+    const Eigen::Vector2f viewer = BlobViewer(blob, point_rig_ids, s.calibration);
+    if (auto heading = objects::DenoisedHeading(r.cloud.xyz, r.cloud.sigma_z_m, blob, viewer,
+                                                s.params.noise_dominated_fraction)) {
+      box = objects::FitVerticalBoxAtHeading(r.cloud.xyz, blob, up, *heading, s.params.box_trim_fraction);
+    }
     r.boxes.push_back(box);
     r.blobs.push_back(std::move(blob));
+    viewers.push_back(viewer);
   }
   r.status.stages.push_back({"boxes", MsSince(t0)});
 
@@ -354,7 +362,6 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   std::vector<double> depth_spreads(r.boxes.size(), 0.0);
   std::vector<bool> on_ground(r.boxes.size(), false);
-  std::vector<Eigen::Vector2f> viewers(r.boxes.size(), Eigen::Vector2f::Zero());
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {
     objects::Detection d = objects::Detection::FromBox(box, cls);
     d.xy_m = (r.T_world_vehicle * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
@@ -368,7 +375,6 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     on_ground[box_index] = bottom_gap_m <= s.params.max_ground_gap_m;
     if (on_ground[box_index]) {
       depth_spreads[box_index] = DepthSpread(r.cloud.sigma_z_m, r.blobs[box_index], s.params.box_trim_fraction);
-      viewers[box_index] = BlobViewer(r.blobs[box_index], point_rig_ids, s.calibration);
       const objects::ViewedBox viewed = objects::ClassifyFromViewpoint(
           s.atlas, box, viewers[box_index], s.params.completion, depth_spreads[box_index]);
       cls = viewed.classification;

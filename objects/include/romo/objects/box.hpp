@@ -52,6 +52,26 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
                     const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ(),
                     std::optional<float> hint_yaw_rad = std::nullopt, float trim_fraction = 0.f);
 
+/// The same cuboid with its heading given (e.g. estimated with the depth noise taken out): the
+/// footprint's (trimmed) extents along @p yaw_rad and across it; the returned yaw is the
+/// equivalent heading nearest @p yaw_rad.
+/// @throws romo::Error as FitVerticalBox, or for a non-finite @p yaw_rad.
+Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
+                             float yaw_rad, float trim_fraction = 0.f);
+
+/// Heading (about z, in the xy plane) of points @p indices seen by stereo from @p viewer_xy, with
+/// the depth noise taken out of their footprint's second moments: the points' covariance less
+/// the mean of sigma_z^2 along each point's sight line. Far surfaces are smeared along the line
+/// of sight (0.4 m at 11 m for half-resolution stereo), and a car's front seen obliquely becomes
+/// a slab that the smallest rectangle follows instead of the face. Nothing when the spread along
+/// the line of sight is not more than @p noise_dominated_fraction noise (then the rectangle fit
+/// is the better one: it is exact for L-shaped outlines, where moments are biased).
+/// @throws romo::Error for bad indices, a sigma_z count unlike the point count, a non-finite
+///         viewer or a negative fraction.
+std::optional<float> DenoisedHeading(const Eigen::Matrix3Xf& xyz, const std::vector<float>& sigma_z_m,
+                                     const std::vector<int>& indices, const Eigen::Vector2f& viewer_xy,
+                                     double noise_dominated_fraction);
+
 /// Canonical heading for a footprint with extents (@p length_m, @p width_m) along a heading
 /// @p yaw_rad: swaps length/width so length >= width and returns the yaw in [-pi/2, pi/2); with
 /// @p hint_yaw_rad, returns the equivalent heading nearest the hint (within pi/2 of it), keeping

@@ -46,6 +46,10 @@ struct PipelineParams {
   double min_object_height_m = 0.5;
   /// Stereo points ignored at each end of a box's axes (depth noise at range, see FitVerticalBox).
   float box_trim_fraction = 0.03f;
+  /// A blob whose spread along the line of sight is more than this fraction depth noise (sigma_z
+  /// along each point's sight line) takes its heading from its footprint's moments with the
+  /// noise taken out, not from the smallest rectangle around the smeared points.
+  double noise_dominated_fraction = 0.5;
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
   objects::ViewCompletionParams completion;
