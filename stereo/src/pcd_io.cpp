@@ -1,11 +1,15 @@
 // The only translation unit of the stereo module that includes PCL (slow to compile).
 #include "romo/stereo/pcd_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/exceptions.h>
@@ -88,6 +92,77 @@ void AddField(pcl::PCLPointCloud2* cloud, const char* name, std::uint32_t offset
   cloud->fields.push_back(f);
 }
 
+// PCL's readHeader allocates width x height x point_step bytes before it reads any data, so a
+// header claiming a 10^14-byte field (or 10^12 points) in a 200-byte file exhausts memory. The
+// sizes are checked against what the file can hold first: binary data is stored as is, ASCII
+// needs at least 2 bytes a value, LZF expands at most ~100 times (its longest back reference).
+void CheckPcdHeaderSizes(const std::string& path, std::uintmax_t file_size) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Fail("PCD file '" + path + "' cannot be opened");
+  std::vector<unsigned long long> sizes, counts;
+  unsigned long long width = 1, height = 1, points_line = 0;
+  std::string data_kind, line;
+  int line_number = 0;
+  auto numbers = [&](std::istringstream& fields, const std::string& key) {
+    std::vector<unsigned long long> out;
+    std::string token;
+    while (fields >> token) {
+      if (token.find_first_not_of("0123456789") != std::string::npos || token.size() > 12) {
+        Fail("PCD file '" + path + "' line " + std::to_string(line_number) + ": " + key + " value '" +
+             token.substr(0, 24) + "' is not a count of a sane size");
+      }
+      out.push_back(std::stoull(token));
+    }
+    return out;
+  };
+  while (data_kind.empty() && in.tellg() < (1 << 20) && std::getline(in, line)) {
+    ++line_number;
+    std::istringstream fields(line);
+    std::string key;
+    fields >> key;
+    if (key == "SIZE") {
+      sizes = numbers(fields, key);
+      for (unsigned long long size : sizes) {
+        if (size != 1 && size != 2 && size != 4 && size != 8) {
+          Fail("PCD file '" + path + "' line " + std::to_string(line_number) + ": SIZE " + std::to_string(size) +
+               " is not 1, 2, 4 or 8 bytes");
+        }
+      }
+    } else if (key == "COUNT") {
+      counts = numbers(fields, key);
+    } else if (key == "WIDTH" || key == "HEIGHT") {
+      const auto v = numbers(fields, key);
+      if (v.size() == 1) (key == "WIDTH" ? width : height) = v[0];
+    } else if (key == "POINTS") {
+      const auto v = numbers(fields, key);
+      if (v.size() == 1) points_line = v[0];
+    } else if (key == "DATA") {
+      fields >> data_kind;
+      if (data_kind.empty()) data_kind = "?";
+    }
+  }
+  if (data_kind.empty()) return;  // no DATA line where PCL would look: it reports that itself
+  if (counts.empty()) counts.assign(sizes.size(), 1);
+  unsigned long long point_step = 0, values = 0;
+  for (std::size_t k = 0; k < sizes.size() && k < counts.size(); ++k) {
+    point_step += sizes[k] * counts[k];  // each factor < 10^12: no overflow
+    values += counts[k];
+  }
+  const double points = std::max(static_cast<double>(width) * static_cast<double>(height),
+                                 static_cast<double>(points_line));
+  const double claimed = data_kind == "ascii" ? points * static_cast<double>(values) * 2.0
+                                              : points * static_cast<double>(point_step);
+  const double room = data_kind == "binary_compressed" ? 100.0 * static_cast<double>(file_size) + 4096.0
+                                                       : static_cast<double>(file_size);
+  if (claimed > room) {
+    std::ostringstream msg;
+    msg << "PCD file '" << path << "' header claims " << width << " x " << height << " points of " << point_step
+        << " bytes (" << data_kind << ", at least " << claimed << " bytes) but the file has " << file_size
+        << " bytes: corrupt WIDTH, HEIGHT, SIZE or COUNT";
+    Fail(msg.str());
+  }
+}
+
 }  // namespace
 
 void SavePcd(const PointCloud& cloud, const std::string& path) {
@@ -149,6 +224,11 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
   }
   // PCL 1.13 crashes on some malformed files (no FIELDS, short binary data), so the header and
   // the data size are checked here before PCL reads the points.
+  {
+    const std::uintmax_t size_before_header = std::filesystem::file_size(path, ec);
+    if (ec) Fail("PCD file '" + path + "': cannot read its size: " + ec.message());
+    CheckPcdHeaderSizes(path, size_before_header);
+  }
   pcl::PCLPointCloud2 header;
   Eigen::Vector4f origin;
   Eigen::Quaternionf orientation;

@@ -123,6 +123,36 @@ TEST(PcdIoTest, CorruptFilesNameThePath) {
   }
 }
 
+TEST(PcdIoTest, HeadersClaimingMoreThanTheFileHoldsAreRefusedBeforeAllocating) {
+  // PCL allocates width x height x point_step bytes from the header alone: these would ask for
+  // 400 GB (ASCII), 8 GB (binary) and 10^14-byte fields in files of ~150 bytes.
+  test::ScratchDir dir;
+  const std::string head = "VERSION 0.7\nFIELDS x y z\n";
+  test::WriteFile(dir / "ascii.pcd", head + "SIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100000000000\nHEIGHT 1\n"
+                                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100000000000\nDATA ascii\n1 2 3\n");
+  test::WriteFile(dir / "binary.pcd", head + "SIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 700000000\nHEIGHT 1\n"
+                                      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 700000000\nDATA binary\n0123456789ab");
+  test::WriteFile(dir / "size.pcd", head + "SIZE 111111111111114 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 16\n"
+                                    "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 16\nDATA binary_compressed\n");
+  test::WriteFile(dir / "size3.pcd", head + "SIZE 3 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  const std::pair<const char*, const char*> cases[] = {
+      {"ascii.pcd", "100000000000 x 1 points"}, {"binary.pcd", "700000000 x 1 points"},
+      {"size.pcd", "SIZE value '111111111111114'"}, {"size3.pcd", "SIZE 3 is not 1, 2, 4 or 8"}};
+  for (const auto& [name, says] : cases) {
+    try {
+      LoadPcd(dir / name);
+      ADD_FAILURE() << name << ": expected romo::Error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+  // A sane file still loads.
+  SavePcd(MakeCloud(), dir / "ok.pcd");
+  EXPECT_EQ(LoadPcd(dir / "ok.pcd").size(), MakeCloud().size());
+}
+
 TEST(PcdIoTest, SaveIntoMissingFolderFailsWithPath) {
   EXPECT_THROW(SavePcd(MakeCloud(), "/nonexistent/romo/out.pcd"), Error);
 }
