@@ -354,4 +354,8 @@ std::unique_ptr<FrameSource> OpenLogSource(const Uri& uri) {
   return std::make_unique<LogReader>(uri.path, options);
 }
 
+Calibration CalibrationFromEvent(const LogEvent& event, const std::string& origin) {
+  return Calibration::FromYaml(lcm_codec::DecodeCalibration(event.data, origin), origin);
+}
+
 }  // namespace romo::drivers

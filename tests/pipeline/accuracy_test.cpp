@@ -30,7 +30,15 @@ TEST(AccuracyTest, DefaultParkingSceneMeetsItsTargetsOrTodaysFloors) {
               e.box_center_err_m_median, static_cast<long long>(e.id_switches),
               static_cast<long long>(e.slot_found_frames), static_cast<long long>(e.slot_visible_frames),
               e.slot_center_err_m, e.slot_yaw_err_deg, static_cast<long long>(e.narrow_reported_feasible));
+  std::printf("FIGURE accuracy, objects the cameras can see (>= %.0f %% of their facing surface): car P %.3f R %.3f "
+              "(%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld)\n",
+              100 * SceneEvalParams{}.min_visible_fraction, e.car_visible.precision(), e.car_visible.recall(),
+              static_cast<long long>(e.car_visible.matched_truths), static_cast<long long>(e.car_visible.truths),
+              e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
+              static_cast<long long>(e.pedestrian_visible.matched_truths),
+              static_cast<long long>(e.pedestrian_visible.truths));
   ASSERT_EQ(e.frames, 40);
+  ASSERT_TRUE(e.visibility_scored) << "romo run writes the calibration into its outputs log";
 
   // Targets met.
   EXPECT_LE(e.slot_yaw_err_deg, 3.0);
@@ -44,6 +52,11 @@ TEST(AccuracyTest, DefaultParkingSceneMeetsItsTargetsOrTodaysFloors) {
   EXPECT_LE(e.box_center_err_m_median, 0.23);
   EXPECT_GE(e.slot_found_frames, e.slot_visible_frames - 2);
   EXPECT_LE(e.slot_center_err_m, 0.27);
+  // Hidden objects (about 40 car and 25 pedestrian sightings) are neither missed nor found there.
+  EXPECT_LT(e.car_visible.truths, e.car.truths);
+  EXPECT_GE(e.car_visible.recall(), e.car.recall());
+  EXPECT_GE(e.car_visible.recall(), 0.37);
+  EXPECT_GE(e.pedestrian_visible.recall(), 0.65);
 }
 
 }  // namespace

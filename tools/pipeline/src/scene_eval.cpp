@@ -11,6 +11,7 @@
 #include "romo/objects/tracking_eval.hpp"
 #include "romo/planning_iface/messages.hpp"
 #include "romo/sim/ground_truth.hpp"
+#include "romo/sim/visibility.hpp"
 
 namespace romo::pipeline {
 namespace pi = planning_iface;
@@ -58,8 +59,15 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   std::int64_t truncated = -1;
   const auto events = drivers::ReadAllEvents(log_path, &truncated);
   std::map<std::int64_t, Frame> frames;  // by stamp_ns
+  std::optional<drivers::Calibration> calibration;
   for (const auto& e : events) {
-    if (e.channel == sim::kGroundTruthChannel) {
+    if (e.channel == drivers::kCalibrationChannel && !calibration) {
+      try {
+        calibration = drivers::CalibrationFromEvent(e, log_path);
+      } catch (const Error&) {
+        // Without a readable calibration the visibility-aware scores are left out (said in the text).
+      }
+    } else if (e.channel == sim::kGroundTruthChannel) {
       auto gt = sim::DecodeGroundTruth(e.data.data(), e.data.size(), log_path);
       const auto stamp = gt.stamp_ns;
       frames[stamp].truth = std::move(gt);
@@ -93,12 +101,15 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
     for (const std::string cls : {"car", "pedestrian"}) {
       std::vector<Eigen::Vector2d> truth, det;
       std::vector<int> truth_id, det_track;
+      std::vector<bool> truth_visible;
       for (const auto& o : f.truth->objects) {
         if (o.class_name != cls) continue;
         const Eigen::Vector2d v = (T_vw * o.center_m).head<2>();
         if (v.norm() > params.range_m) continue;
         truth.push_back(v);
         truth_id.push_back(o.id);
+        truth_visible.push_back(calibration && sim::VisibleFraction(o, f.truth->objects, *calibration, T_wv) >=
+                                                   params.min_visible_fraction);
       }
       for (const auto& o : f.obstacles->obstacles) {
         if (o.class_name != cls || o.center_m.head<2>().norm() > params.range_m) continue;
@@ -111,6 +122,16 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
       score.detections += static_cast<std::int64_t>(det.size());
       score.matched_truths += static_cast<std::int64_t>(m.size());
       score.matched_detections += static_cast<std::int64_t>(m.size());
+      if (calibration) {
+        // Hidden truths are "don't care": neither a miss nor, when detected anyway, a false alarm.
+        ClassScore& seen = cls == "car" ? out.car_visible : out.pedestrian_visible;
+        std::int64_t matched_visible = 0, matched_hidden = 0;
+        for (const auto& [i, j] : m) (truth_visible[i] ? matched_visible : matched_hidden) += 1;
+        seen.truths += std::count(truth_visible.begin(), truth_visible.end(), true);
+        seen.detections += static_cast<std::int64_t>(det.size()) - matched_hidden;
+        seen.matched_truths += matched_visible;
+        seen.matched_detections += matched_visible;
+      }
       for (const auto& [i, j] : m) center_errors.push_back((truth[i] - det[j]).norm());
       for (std::size_t i = 0; i < truth.size(); ++i) gt_ids.push_back({truth_id[i], truth[i]});
       for (std::size_t j = 0; j < det.size(); ++j) {
@@ -186,6 +207,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
     Fail("eval scene: " + log_path + " has no frame with both ground truth (" +
          sim::kGroundTruthChannel + ") and outputs (" + pi::kObstaclesChannel + ")");
   }
+  out.visibility_scored = calibration.has_value();
   out.box_center_err_m_median = Median(center_errors);
   out.id_switches = switches.score().id_switches;
   out.predictions_scored = static_cast<std::int64_t>(ade_list.size());
@@ -205,7 +227,13 @@ std::string SceneEval::ToJson() const {
      << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
      << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
      << ", \"center_err_m\":" << slot_center_err_m << ", \"yaw_err_deg\":" << slot_yaw_err_deg
-     << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}}";
+     << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}";
+  if (visibility_scored) {
+    js << ", \"car_visible\":{\"precision\":" << car_visible.precision() << ", \"recall\":" << car_visible.recall()
+       << "}, \"pedestrian_visible\":{\"precision\":" << pedestrian_visible.precision()
+       << ", \"recall\":" << pedestrian_visible.recall() << "}";
+  }
+  js << "}";
   return js.str();
 }
 
@@ -218,7 +246,14 @@ std::string SceneEval::ToText() const {
     << "pedestrians (<= 15 m): precision " << pedestrian.precision() << "  recall " << pedestrian.recall()
     << "  (" << pedestrian.matched_truths << "/" << pedestrian.truths << " found, " << pedestrian.detections
     << " detections)\n"
-    << "box centre error median: " << box_center_err_m_median << " m   ID switches: " << id_switches << "\n"
+    << (visibility_scored ? "" : "(no calibration in the log: objects hidden from the cameras count as misses)\n");
+  if (visibility_scored) {
+    t << "visible to the cameras: cars precision " << car_visible.precision() << "  recall " << car_visible.recall()
+      << "  (" << car_visible.matched_truths << "/" << car_visible.truths << ");  pedestrians precision "
+      << pedestrian_visible.precision() << "  recall " << pedestrian_visible.recall() << "  ("
+      << pedestrian_visible.matched_truths << "/" << pedestrian_visible.truths << ")\n";
+  }
+  t << "box centre error median: " << box_center_err_m_median << " m   ID switches: " << id_switches << "\n"
     << "pedestrian prediction:  ADE " << ade_m << " m  FDE " << fde_m << " m (" << predictions_scored
     << " predictions scored)\n"
     << "parking slot: found in " << slot_found_frames << "/" << slot_visible_frames

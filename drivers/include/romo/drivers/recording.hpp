@@ -117,6 +117,10 @@ std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* trunc
 /// @throws romo::Error when the file is missing or not an LCM log.
 std::int64_t ScanEvents(const std::string& path, const std::function<void(const LogEvent&)>& visit);
 
+/// The calibration carried by a ROMO_CALIBRATION event (e.g. from ReadAllEvents).
+/// @throws romo::Error naming @p origin when it does not decode or validate.
+Calibration CalibrationFromEvent(const LogEvent& event, const std::string& origin);
+
 /// The frame_sequence carried by a frame-part event (stereo, RGB-D, vehicle state, GNSS), or
 /// nullopt for other channels or too-short data.
 std::optional<std::uint64_t> FrameSequenceOf(const LogEvent& event);

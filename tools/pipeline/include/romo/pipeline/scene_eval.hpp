@@ -13,6 +13,10 @@ struct SceneEvalParams {
   double pedestrian_match_m = 0.8;
   double slot_match_m = 1.0;          ///< reported slot centre to bay centre for a match
   double bay_visible_range_m = 10.0;  ///< a bay this close to the ego counts as fully visible
+  /// For the "visible" scores: a truth counts when at least this fraction of its surface turned
+  /// to the cameras is in some rig's view and not hidden behind another object (sim::VisibleFraction);
+  /// a detection of a hidden one is neither right nor wrong there.
+  double min_visible_fraction = 0.25;
 };
 
 struct ClassScore {
@@ -23,7 +27,10 @@ struct ClassScore {
 
 struct SceneEval {
   std::int64_t frames = 0;
-  ClassScore car, pedestrian;
+  ClassScore car, pedestrian;  ///< every truth within range
+  /// Only truths the cameras can see (needs the calibration in the log: visibility_scored).
+  ClassScore car_visible, pedestrian_visible;
+  bool visibility_scored = false;
   double box_center_err_m_median = 0.0;
   std::int64_t id_switches = 0;
   double ade_m = 0.0, fde_m = 0.0;
