@@ -11,6 +11,14 @@
 #include "cli/command_registry.hpp"
 #include "romo/core/json.hpp"
 #include "romo/drivers/recording.hpp"
+#include "romo_lcm/ground_truth_t.hpp"
+#include "romo_lcm/gt_depth_t.hpp"
+#include "romo_lcm/manip_result_t.hpp"
+#include "romo_lcm/obstacle_list_t.hpp"
+#include "romo_lcm/parking_slots_t.hpp"
+#include "romo_lcm/pedestrian_predictions_t.hpp"
+#include "romo_lcm/perception_status_t.hpp"
+#include "romo_lcm/rig_cloud_t.hpp"
 
 namespace romo::tools {
 namespace {
@@ -32,7 +40,21 @@ struct ChannelStats {
   double rate_hz() const { return count > 1 && last_us > first_us ? (count - 1) / span_s() : 0.0; }
 };
 
+// The drivers know the sensor types; the outputs, ground truth and worker clouds a run or a
+// simulation writes into the same logs are named here, where they are listed.
+void RegisterOutputTypes() {
+  drivers::RegisterLcmType(romo_lcm::ground_truth_t::getHash(), "romo_lcm.ground_truth_t");
+  drivers::RegisterLcmType(romo_lcm::gt_depth_t::getHash(), "romo_lcm.gt_depth_t");
+  drivers::RegisterLcmType(romo_lcm::manip_result_t::getHash(), "romo_lcm.manip_result_t");
+  drivers::RegisterLcmType(romo_lcm::obstacle_list_t::getHash(), "romo_lcm.obstacle_list_t");
+  drivers::RegisterLcmType(romo_lcm::parking_slots_t::getHash(), "romo_lcm.parking_slots_t");
+  drivers::RegisterLcmType(romo_lcm::pedestrian_predictions_t::getHash(), "romo_lcm.pedestrian_predictions_t");
+  drivers::RegisterLcmType(romo_lcm::perception_status_t::getHash(), "romo_lcm.perception_status_t");
+  drivers::RegisterLcmType(romo_lcm::rig_cloud_t::getHash(), "romo_lcm.rig_cloud_t");
+}
+
 void Info(const std::string& path, bool json) {
+  RegisterOutputTypes();
   std::map<std::string, ChannelStats> channels;
   std::int64_t first_us = 0;
   std::int64_t last_us = 0;

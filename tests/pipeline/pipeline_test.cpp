@@ -84,6 +84,17 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
                           "\"id_switches\"", "\"prediction\"", "\"slot\"", "\"narrow_reported_feasible\""}) {
     EXPECT_NE(eval.find(key), std::string::npos) << key << " in " << eval;
   }
+  // The outputs log spans the run (the calibration is stamped like the first frame, not at 0) and
+  // `romo info` names the output types.
+  const auto info = romo::test::RunRomo("info --json " + (dir / "outputs.lcmlog"));
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const std::size_t span = info.out.find("\"span_s\":");
+  ASSERT_NE(span, std::string::npos) << info.out;
+  EXPECT_LT(std::stod(info.out.substr(span + 9)), 5.0) << info.out;  // 2 frames at 2.7 Hz: 0.37 s
+  for (const char* type : {"romo_lcm.obstacle_list_t", "romo_lcm.parking_slots_t", "romo_lcm.perception_status_t",
+                           "romo_lcm.pedestrian_predictions_t", "romo_lcm.ground_truth_t"}) {
+    EXPECT_NE(info.out.find(type), std::string::npos) << type << " in " << info.out;
+  }
   const auto json = romo::test::RunRomo("eval scene --json --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(json.exit_code, 0) << json.err;
   EXPECT_NE(json.out.find("\"frames\":2"), std::string::npos) << json.out;

@@ -52,8 +52,18 @@ class OutputSink::Impl {
   std::int64_t frames_with_feasible_slot = 0;
   std::int64_t dropped = 0, malformed = 0;
 
+  // The calibration goes first into the log, stamped like the first event after it (not 0), so
+  // the log's span and seek offsets start at the first frame.
+  std::optional<drivers::Calibration> calibration_to_log;
+  void LogCalibrationOnce(std::int64_t stamp_ns) {
+    if (!log || !calibration_to_log) return;
+    log->WriteCalibration(*calibration_to_log, stamp_ns);
+    calibration_to_log.reset();
+  }
+
   // One output message into the log and onto the bus (each when open).
   void Emit(const std::string& channel, std::int64_t stamp_ns, const std::vector<std::uint8_t>& bytes) {
+    LogCalibrationOnce(stamp_ns);
     if (log) log->WriteRaw(channel, stamp_ns, bytes.data(), bytes.size());
     if (bus) bus->Publish(channel, bytes);
   }
@@ -77,7 +87,7 @@ OutputSink::OutputSink(const drivers::Calibration& calibration, const OutputOpti
     fs::create_directories(fs::path(options.out_dir) / "frames", ec);
     if (ec) Fail("outputs: cannot create folder " + options.out_dir + ": " + ec.message());
     impl_->log = std::make_unique<drivers::LogWriter>(options.out_dir + "/outputs.lcmlog");
-    impl_->log->WriteCalibration(calibration, 0);
+    impl_->calibration_to_log = calibration;
     impl_->csv = std::make_unique<objects::PredictionCsvWriter>(options.out_dir + "/predictions.csv");
   }
   if (!options.lcm_url.empty()) impl_->bus = std::make_unique<pi::LcmBus>(options.lcm_url);
@@ -107,6 +117,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
       {objects::kPedestrianPredictionChannel,
        objects::EncodePedestrianPredictions(r.stamp_ns, r.frame_sequence, r.predictions)}};
   if (s.log) {
+    s.LogCalibrationOnce(r.stamp_ns);
     if (inputs != nullptr && s.options.log_inputs) s.log->Write(*inputs);
     for (const auto& e : passthrough) {
       s.log->WriteRaw(e.channel, r.stamp_ns, e.data.data(), e.data.size());
@@ -162,6 +173,7 @@ void OutputSink::Finish(const std::string& extra_json) {
   Impl& s = *impl_;
   if (s.finished) return;
   s.finished = true;
+  s.LogCalibrationOnce(0);  // a run without any frame still says what it ran on
   if (s.log) s.log->Close();
   if (s.csv) s.csv->Close();
   if (s.options.out_dir.empty()) return;
