@@ -79,7 +79,15 @@ bool StemLess(const std::string& a, const std::string& b) {
   return a < b;
 }
 
-std::int64_t SecondsToNs(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+// Nanoseconds of a list's stamp; stamps beyond what int64 nanoseconds hold (292 years either side
+// of 1970) are refused with @p where named.
+std::int64_t SecondsToNs(double s, const std::string& where) {
+  constexpr double kMaxS = 9.2e9;
+  if (!(std::abs(s) < kMaxS)) {
+    Fail(where + ": timestamp " + std::to_string(s) + " s is not a time (beyond +-9.2e9 s)");
+  }
+  return static_cast<std::int64_t>(std::llround(s * 1e9));
+}
 
 // "timestamp file" lines; '#' comments.
 std::vector<std::pair<double, std::string>> ReadStampList(const std::string& path) {
@@ -97,6 +105,7 @@ std::vector<std::pair<double, std::string>> ReadStampList(const std::string& pat
     if (!(fields >> stamp >> file) || !std::isfinite(stamp)) {
       Fail(path + ":" + std::to_string(number) + ": expected 'timestamp file', got '" + line + "'");
     }
+    SecondsToNs(stamp, path + ":" + std::to_string(number));
     entries.emplace_back(stamp, file);
   }
   std::sort(entries.begin(), entries.end());
@@ -209,7 +218,7 @@ std::vector<Pair> PairByTimestamp(const std::string& folder,
     }
     used[static_cast<std::size_t>(best)] = true;
     pairs.push_back({folder + "/" + file, folder + "/" + depth[static_cast<std::size_t>(best)].second,
-                     SecondsToNs(t), true});
+                     SecondsToNs(t, folder + "/rgb.txt"), true});
   }
   *unpaired += static_cast<std::uint64_t>(std::count(used.begin(), used.end(), false));
   return pairs;
@@ -252,7 +261,8 @@ std::unique_ptr<FrameSource> OpenRgbdSource(const Uri& uri) {
         Fail(folder + "/associations.txt:" + std::to_string(number) +
              ": expected 't_rgb rgb_file t_depth depth_file', got '" + line + "'");
       }
-      pairs.push_back({folder + "/" + rgb, folder + "/" + depth, SecondsToNs(t_rgb), true});
+      pairs.push_back({folder + "/" + rgb, folder + "/" + depth,
+                       SecondsToNs(t_rgb, folder + "/associations.txt:" + std::to_string(number)), true});
     }
   } else if (IsFile(folder + "/rgb.txt") && IsFile(folder + "/depth.txt")) {
     layout = "TUM rgb.txt/depth.txt";
@@ -328,7 +338,7 @@ std::unique_ptr<FrameSource> OpenRgbdSource(const Uri& uri) {
       if (!IsFile(*file)) Fail(folder + ": listed image " + *file + " not found");
     }
     if (!pairs[i].has_stamp) {
-      pairs[i].stamp_ns = SecondsToNs(static_cast<double>(i) / rate_hz);
+      pairs[i].stamp_ns = SecondsToNs(static_cast<double>(i) / rate_hz, uri.ToString() + ": frame " + std::to_string(i) + " at rate_hz");
     }
   }
   if (const auto scale = uri.GetDouble("depth_scale")) {

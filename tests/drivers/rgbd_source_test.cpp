@@ -143,6 +143,14 @@ TEST(RgbdSourceTest, BadFoldersAndFilesGiveClearErrors) {
   test::WriteFile(dir / "rgb.txt", "1.0 rgb/x.png\n");
   EXPECT_NE(ErrorOf([&] { OpenSource("rgbd://" + dir.path()); }).find("rgb/x.png not found"),
             std::string::npos);
+  // A stamp no int64 nanosecond count holds is named (llround would have returned garbage).
+  test::WriteFile(dir / "depth.txt", "1.0 depth/x.png\n2e10 depth/y.png\n");
+  EXPECT_NE(ErrorOf([&] { OpenSource("rgbd://" + dir.path()); }).find(dir / "depth.txt:2: timestamp"),
+            std::string::npos);
+  test::WriteFile(dir / "associations.txt", "1e300 rgb/a.png 1 depth/a.png\n");
+  EXPECT_NE(ErrorOf([&] { OpenSource("rgbd://" + dir.path()); })
+                .find(dir / "associations.txt:1: timestamp 1000000"),
+            std::string::npos);
 }
 
 }  // namespace
