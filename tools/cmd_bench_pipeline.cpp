@@ -1,7 +1,10 @@
 // `romo bench pipeline`: per-stage and end-to-end latency and rate of the 6-rig frame at full and
 // half resolution with 1 and 2 threads, and each stage's share. Frames are rendered first (the
-// simulator is not part of the measurement).
+// simulator is not part of the measurement). Two optional steps are also timed against their
+// baseline, the same frames without them (2 threads): the stereo outline filter
+// (max_disparity_spread) in the stereo stage, the de-noised heading in the boxes stage.
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -23,7 +26,7 @@ struct BenchOptions {
 };
 
 void Bench(const BenchOptions& o) {
-  std::ostringstream js;
+  std::ostringstream js, baselines;
   js << "{\"cases\":[";
   bool first = true;
   for (double scale : {1.0, 0.5}) {
@@ -34,24 +37,36 @@ void Bench(const BenchOptions& o) {
     sim::SimSource source(sp);
     std::vector<drivers::FrameSet> frames;
     while (auto f = source.Next()) frames.push_back(std::move(*f));
-    for (int threads : {1, 2}) {
+    auto params_for = [&](int threads) {
       pipeline::PipelineParams params;
       params.threads = threads;
       params.disparity_size = scale < 0.75 ? 64 : 128;
+      return params;
+    };
+    const double n = static_cast<double>(frames.size() - 1);
+    // Mean stage latencies over the frames after a warm-up (allocations, first RANSAC).
+    auto measure = [&](const pipeline::PipelineParams& params, std::vector<std::string>* order, double* total) {
       pipeline::Pipeline pipe(*source.calibration(), params);
       std::map<std::string, double> sum;
-      std::vector<std::string> order;
-      double total = 0;
+      *total = 0;
       for (std::size_t i = 0; i < frames.size(); ++i) {
         const auto r = pipe.Process(frames[i]);
-        if (i == 0) continue;  // warm-up: allocations, first RANSAC
+        if (i == 0) continue;
         for (const auto& st : r.status.stages) {
-          if (!sum.count(st.name)) order.push_back(st.name);
-          sum[st.name] += st.latency_ms;
+          if (!sum.count(st.name) && order) order->push_back(st.name);
+          sum[st.name] += st.latency_ms / n;
         }
-        total += r.status.total_latency_ms;
+        *total += r.status.total_latency_ms;
       }
-      const double n = static_cast<double>(frames.size() - 1);
+      return sum;
+    };
+    std::map<std::string, double> with_both;
+    for (int threads : {1, 2}) {
+      std::vector<std::string> order;
+      double total = 0;
+      std::map<std::string, double> sum = measure(params_for(threads), &order, &total);
+      if (threads == 2) with_both = sum;
+      for (auto& [stage, ms] : sum) ms *= n;  // the printing below divides by n
       std::printf("\n%s resolution (%dx%d), %d thread%s: end-to-end %.1f ms = %.2f Hz\n",
                   scale == 1.0 ? "full" : "half", source.calibration()->rigs[0].width_px,
                   source.calibration()->rigs[0].height_px, threads, threads > 1 ? "s" : "", total / n,
@@ -66,8 +81,23 @@ void Bench(const BenchOptions& o) {
       }
       js << "}}";
     }
+    // Baselines: the same frames without each optional step.
+    double unused = 0;
+    pipeline::PipelineParams no_filter = params_for(2);
+    no_filter.max_disparity_spread = 0.0;
+    const double stereo_without = measure(no_filter, nullptr, &unused)["stereo"];
+    pipeline::PipelineParams no_denoise = params_for(2);
+    no_denoise.noise_dominated_fraction = std::numeric_limits<double>::infinity();
+    const double boxes_without = measure(no_denoise, nullptr, &unused)["boxes"];
+    std::printf("  vs baselines (2 threads): stereo with the outline filter %.1f ms / %.1f ms without = %.3f; "
+                "boxes with the de-noised heading %.1f ms / %.1f ms without = %.3f\n",
+                with_both["stereo"], stereo_without, with_both["stereo"] / stereo_without, with_both["boxes"],
+                boxes_without, with_both["boxes"] / boxes_without);
+    baselines << (baselines.tellp() > 0 ? "," : "") << "{\"scale\":" << scale
+              << ",\"stereo_outline_filter_ratio\":" << with_both["stereo"] / stereo_without
+              << ",\"boxes_denoised_heading_ratio\":" << with_both["boxes"] / boxes_without << "}";
   }
-  js << "]}";
+  js << "],\"baselines\":[" << baselines.str() << "]}";
   if (o.json) std::printf("%s\n", js.str().c_str());
 }
 
