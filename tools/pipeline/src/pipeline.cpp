@@ -139,7 +139,64 @@ class Pipeline::Impl {
         atlas(objects::Atlas::Load(p.atlas_path.empty() ? objects::Atlas::DefaultPath() : p.atlas_path)),
         tracker(atlas, p.tracker),
         slots(p.parking),
-        stereo(c, StereoParamsOf(p), p.threads) {}
+        stereo(c, StereoParamsOf(p), p.threads) {
+    for (const std::string& name : p.fragment_merge_classes) merge_classes.push_back(atlas.Require(name));
+  }
+
+  // A box as FitVerticalBox gives it, or along its de-noised heading when depth noise dominates.
+  objects::Box3 FitBox(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& up,
+                       std::optional<float> hint, const Eigen::Vector2f& viewer) const {
+    if (auto heading = objects::DenoisedHeading(cloud.xyz, cloud.sigma_z_m, blob, viewer,
+                                                params.noise_dominated_fraction)) {
+      return objects::FitVerticalBoxAtHeading(cloud.xyz, blob, up, *heading, params.box_trim_fraction);
+    }
+    return objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction);
+  }
+
+  // The class a box standing on the ground is seen as, or -1 for one floating above it.
+  int ClassOf(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob,
+              const Eigen::Vector3f& up, const Eigen::Vector2f& viewer) const {
+    const float gap = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
+    if (gap > params.max_ground_gap_m) return -1;
+    return objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion,
+                                          DepthSpread(r.cloud.sigma_z_m, blob, params.box_trim_fraction))
+        .classification.class_index;
+  }
+
+  // Merges pairs of unclassified neighbouring blobs whose union is a merge class, until none is
+  // left (PipelineParams::fragment_merge_gap_m).
+  void MergeFragments(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers) const {
+    if (params.fragment_merge_gap_m <= 0.0) return;
+    std::vector<bool> unknown(r.boxes.size());
+    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+      unknown[i] = ClassOf(r, r.boxes[i], r.blobs[i], up, (*viewers)[i]) == atlas.unknown_index();
+    }
+    for (bool merged = true; merged;) {
+      merged = false;
+      for (std::size_t i = 0; i < r.boxes.size() && !merged; ++i) {
+        for (std::size_t j = i + 1; j < r.boxes.size() && unknown[i] && !merged; ++j) {
+          if (!unknown[j]) continue;
+          // Centre distance less both half diagonals: a lower bound of the footprints' gap.
+          const float gap = (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() -
+                            0.5f * (r.boxes[i].size.head<2>().norm() + r.boxes[j].size.head<2>().norm());
+          if (gap > params.fragment_merge_gap_m) continue;
+          std::vector<int> blob = r.blobs[i];
+          blob.insert(blob.end(), r.blobs[j].begin(), r.blobs[j].end());
+          const objects::Box3 box = FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]);
+          const int c = ClassOf(r, box, blob, up, (*viewers)[i]);
+          if (std::find(merge_classes.begin(), merge_classes.end(), c) == merge_classes.end()) continue;
+          r.boxes[i] = box;
+          r.blobs[i] = std::move(blob);
+          unknown[i] = false;
+          r.boxes.erase(r.boxes.begin() + static_cast<std::ptrdiff_t>(j));
+          r.blobs.erase(r.blobs.begin() + static_cast<std::ptrdiff_t>(j));
+          viewers->erase(viewers->begin() + static_cast<std::ptrdiff_t>(j));
+          unknown.erase(unknown.begin() + static_cast<std::ptrdiff_t>(j));
+          merged = true;
+        }
+      }
+    }
+  }
 
   static stereo::StereoParams StereoParamsOf(const PipelineParams& p) {
     stereo::StereoParams sp;
@@ -154,6 +211,7 @@ class Pipeline::Impl {
   drivers::Calibration calibration;
   PipelineParams params;
   objects::Atlas atlas;
+  std::vector<int> merge_classes;  // fragment_merge_classes as atlas indices
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
@@ -341,17 +399,14 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
         (r.T_world_vehicle * Eigen::Vector3d(c.x(), c.y(), 0.0)).head<2>();
     std::optional<float> hint;
     if (auto h = s.tracker.YawHint(c_world)) hint = static_cast<float>(*h - r.ego_world.yaw_rad);
-    objects::Box3 box = objects::FitVerticalBox(r.cloud.xyz, blob, up, hint, s.params.box_trim_fraction);
-    if (box.size.z() < s.params.min_object_height_m) continue;
     const Eigen::Vector2f viewer = BlobViewer(blob, point_rig_ids, s.calibration);
-    if (auto heading = objects::DenoisedHeading(r.cloud.xyz, r.cloud.sigma_z_m, blob, viewer,
-                                                s.params.noise_dominated_fraction)) {
-      box = objects::FitVerticalBoxAtHeading(r.cloud.xyz, blob, up, *heading, s.params.box_trim_fraction);
-    }
+    const objects::Box3 box = s.FitBox(r.cloud, blob, up, hint, viewer);
+    if (box.size.z() < s.params.min_object_height_m) continue;
     r.boxes.push_back(box);
     r.blobs.push_back(std::move(blob));
     viewers.push_back(viewer);
   }
+  s.MergeFragments(r, up, &viewers);
   r.status.stages.push_back({"boxes", MsSince(t0)});
 
   // Stage: classes (Atlas priors, seen from the vehicle), completed boxes, detections in the

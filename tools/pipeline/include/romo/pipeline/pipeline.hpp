@@ -50,6 +50,12 @@ struct PipelineParams {
   /// along each point's sight line) takes its heading from its footprint's moments with the
   /// noise taken out, not from the smallest rectangle around the smeared points.
   double noise_dominated_fraction = 0.5;
+  /// Blobs of no class closer than this (footprints' gap, m) whose union is one of
+  /// fragment_merge_classes are merged: far car fronts split by depth noise and stereo gaps into
+  /// pieces too narrow for anything. Pedestrians are never formed this way (a person does not
+  /// fragment, and merging would hide a person beside a car's front); 0 turns merging off.
+  double fragment_merge_gap_m = 1.0;
+  std::vector<std::string> fragment_merge_classes = {"car"};
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
   objects::ViewCompletionParams completion;
