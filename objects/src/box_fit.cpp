@@ -311,9 +311,10 @@ std::optional<float> DenoisedHeading(const Eigen::Matrix3Xf& xyz, const std::vec
     const Eigen::Vector2d p = xyz.col(i).head<2>().cast<double>();
     points += (p - mean) * (p - mean).transpose();
     const Eigen::Vector2d sight = p - viewer_xy.cast<double>();
-    if (sight.norm() < 1e-6) continue;
+    const double range = sight.norm();
+    if (range < 1e-6) continue;
     const double sigma = sigma_z_m[static_cast<std::size_t>(i)];
-    noise += sigma * sigma * sight.normalized() * sight.normalized().transpose();
+    noise += (sigma * sigma / (range * range)) * sight * sight.transpose();
   }
   points /= static_cast<double>(indices.size());
   noise /= static_cast<double>(indices.size());

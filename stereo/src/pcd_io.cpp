@@ -224,11 +224,9 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
   }
   // PCL 1.13 crashes on some malformed files (no FIELDS, short binary data), so the header and
   // the data size are checked here before PCL reads the points.
-  {
-    const std::uintmax_t size_before_header = std::filesystem::file_size(path, ec);
-    if (ec) Fail("PCD file '" + path + "': cannot read its size: " + ec.message());
-    CheckPcdHeaderSizes(path, size_before_header);
-  }
+  const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) Fail("PCD file '" + path + "': cannot read its size: " + ec.message());
+  CheckPcdHeaderSizes(path, file_size);
   pcl::PCLPointCloud2 header;
   Eigen::Vector4f origin;
   Eigen::Quaternionf orientation;
@@ -252,8 +250,6 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
     if (stats != nullptr) *stats = PcdLoadStats{};
     return PointCloud{};
   }
-  const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
-  if (ec) Fail("PCD file '" + path + "': cannot read its size: " + ec.message());
   const std::uintmax_t data_bytes = static_cast<std::uintmax_t>(n) * header.point_step;
   if (data_type == 1 && file_size < data_idx + data_bytes) {
     Fail("PCD file '" + path + "' is truncated: binary data of " + std::to_string(n) +

@@ -153,29 +153,38 @@ class Pipeline::Impl {
     return objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction);
   }
 
-  // The class a box standing on the ground is seen as, or -1 for one floating above it.
-  int ClassOf(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob,
-              const Eigen::Vector3f& up, const Eigen::Vector2f& viewer) const {
-    const float gap = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
-    if (gap > params.max_ground_gap_m) return -1;
-    return objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion,
-                                          DepthSpread(r.cloud.sigma_z_m, blob, params.box_trim_fraction))
-        .classification.class_index;
+  // What a box is seen as: on the ground, its class and completed box from the viewer; floating
+  // above it (stereo mismatches, overhangs), unknown and as measured.
+  struct Seen {
+    bool on_ground = false;
+    double depth_spread_m = 0.0;
+    objects::ViewedBox viewed;
+  };
+  Seen See(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob, const Eigen::Vector3f& up,
+           const Eigen::Vector2f& viewer) const {
+    Seen seen;
+    seen.viewed.box = box;
+    seen.viewed.classification = {atlas.unknown_index(), 1.0};
+    seen.on_ground = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z())) <= params.max_ground_gap_m;
+    if (!seen.on_ground) return seen;
+    seen.depth_spread_m = DepthSpread(r.cloud.sigma_z_m, blob, params.box_trim_fraction);
+    seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
+    return seen;
+  }
+  bool Unclassified(const Seen& seen) const {
+    return seen.on_ground && seen.viewed.classification.class_index == atlas.unknown_index();
   }
 
   // Merges pairs of unclassified neighbouring blobs whose union is a merge class, until none is
-  // left (PipelineParams::fragment_merge_gap_m).
-  void MergeFragments(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers) const {
+  // left (PipelineParams::fragment_merge_gap_m); @p viewers and @p seen follow the boxes.
+  void MergeFragments(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                      std::vector<Seen>* seen) const {
     if (params.fragment_merge_gap_m <= 0.0) return;
-    std::vector<bool> unknown(r.boxes.size());
-    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
-      unknown[i] = ClassOf(r, r.boxes[i], r.blobs[i], up, (*viewers)[i]) == atlas.unknown_index();
-    }
     for (bool merged = true; merged;) {
       merged = false;
       for (std::size_t i = 0; i < r.boxes.size() && !merged; ++i) {
-        for (std::size_t j = i + 1; j < r.boxes.size() && unknown[i] && !merged; ++j) {
-          if (!unknown[j]) continue;
+        for (std::size_t j = i + 1; j < r.boxes.size() && Unclassified((*seen)[i]) && !merged; ++j) {
+          if (!Unclassified((*seen)[j])) continue;
           // Centre distance less both half diagonals: a lower bound of the footprints' gap.
           const float gap = (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() -
                             0.5f * (r.boxes[i].size.head<2>().norm() + r.boxes[j].size.head<2>().norm());
@@ -183,15 +192,19 @@ class Pipeline::Impl {
           std::vector<int> blob = r.blobs[i];
           blob.insert(blob.end(), r.blobs[j].begin(), r.blobs[j].end());
           const objects::Box3 box = FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]);
-          const int c = ClassOf(r, box, blob, up, (*viewers)[i]);
-          if (std::find(merge_classes.begin(), merge_classes.end(), c) == merge_classes.end()) continue;
+          Seen union_seen = See(r, box, blob, up, (*viewers)[i]);
+          const int c = union_seen.viewed.classification.class_index;
+          if (!union_seen.on_ground || std::find(merge_classes.begin(), merge_classes.end(), c) == merge_classes.end()) {
+            continue;
+          }
           r.boxes[i] = box;
           r.blobs[i] = std::move(blob);
-          unknown[i] = false;
-          r.boxes.erase(r.boxes.begin() + static_cast<std::ptrdiff_t>(j));
-          r.blobs.erase(r.blobs.begin() + static_cast<std::ptrdiff_t>(j));
-          viewers->erase(viewers->begin() + static_cast<std::ptrdiff_t>(j));
-          unknown.erase(unknown.begin() + static_cast<std::ptrdiff_t>(j));
+          (*seen)[i] = std::move(union_seen);
+          const auto at = static_cast<std::ptrdiff_t>(j);
+          r.boxes.erase(r.boxes.begin() + at);
+          r.blobs.erase(r.blobs.begin() + at);
+          viewers->erase(viewers->begin() + at);
+          seen->erase(seen->begin() + at);
           merged = true;
         }
       }
@@ -406,17 +419,17 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     r.blobs.push_back(std::move(blob));
     viewers.push_back(viewer);
   }
-  s.MergeFragments(r, up, &viewers);
   r.status.stages.push_back({"boxes", MsSince(t0)});
 
-  // Stage: classes (Atlas priors, seen from the vehicle), completed boxes, detections in the
-  // world frame for tracking. Cars and pedestrians stand on the ground: a blob floating above
-  // it (stereo mismatches, overhangs) stays an obstacle of unknown class.
+  // Stage: classes (Atlas priors, seen from the camera that saw each blob), unclassified pieces
+  // that make a car together merged, completed boxes, detections in the world frame for tracking.
+  // Cars and pedestrians stand on the ground: a blob floating above it stays of unknown class.
   t0 = Clock::now();
+  std::vector<Pipeline::Impl::Seen> seen;
+  for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], up, viewers[i]));
+  s.MergeFragments(r, up, &viewers, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
-  std::vector<double> depth_spreads(r.boxes.size(), 0.0);
-  std::vector<bool> on_ground(r.boxes.size(), false);
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {
     objects::Detection d = objects::Detection::FromBox(box, cls);
     d.xy_m = (r.T_world_vehicle * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
@@ -424,18 +437,8 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     return d;
   };
   for (std::size_t box_index = 0; box_index < r.boxes.size(); ++box_index) {
-    objects::Box3& box = r.boxes[box_index];
-    const float bottom_gap_m = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
-    objects::Classification cls{s.atlas.unknown_index(), 1.0};
-    on_ground[box_index] = bottom_gap_m <= s.params.max_ground_gap_m;
-    if (on_ground[box_index]) {
-      depth_spreads[box_index] = DepthSpread(r.cloud.sigma_z_m, r.blobs[box_index], s.params.box_trim_fraction);
-      const objects::ViewedBox viewed = objects::ClassifyFromViewpoint(
-          s.atlas, box, viewers[box_index], s.params.completion, depth_spreads[box_index]);
-      cls = viewed.classification;
-      box = viewed.box;
-    }
-    const objects::Detection d = world_detection(box, cls);
+    r.boxes[box_index] = seen[box_index].viewed.box;
+    const objects::Detection d = world_detection(r.boxes[box_index], seen[box_index].viewed.classification);
     r.box_classes.push_back(s.atlas.classes()[d.classification.class_index].name);
     detections.push_back(d);
   }
@@ -450,13 +453,13 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // extents can be one (a fragment too low for a car stays unknown).
   for (const objects::Track& tr : r.tracks) {
     const int i = tr.detection_index;
-    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !on_ground[i]) continue;
+    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground) continue;
     if (tr.class_index < 0 || tr.class_index == s.atlas.unknown_index() ||
         tr.class_index == detections[i].classification.class_index) {
       continue;
     }
     const objects::ViewedBox viewed = objects::CompleteAsClass(s.atlas, tr.class_index, measured_boxes[i],
-                                                               viewers[i], s.params.completion, depth_spreads[i]);
+                                                               viewers[i], s.params.completion, seen[i].depth_spread_m);
     if (viewed.classification.class_index != tr.class_index) continue;
     r.boxes[i] = viewed.box;
     r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].name;
