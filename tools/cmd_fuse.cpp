@@ -70,9 +70,14 @@ struct Received {
   bool overflow = false;
 };
 
-// Takes messages off LCM on a thread of its own, so none is lost while a frame is being fused:
-// LCM queues at most 30 messages per subscription and drops the rest unseen, fewer than a few
-// frames of six rigs. Bounded by bytes; what does not fit is counted, not silently lost.
+// Takes messages off LCM on a thread of its own, so none is lost while a frame is being fused.
+// Bounded by bytes; what does not fit is counted, not silently lost.
+//
+// LCM's own queue between its reader thread and this one holds 30 messages by default and drops
+// the rest unseen: on a busy machine this thread can wait for a core while a burst of a few
+// frames (6 rigs x (cloud + faults)) arrives. Found in CI: a frame's six clouds lost after four
+// frames' bursts. 512 is 85 frames of six rigs; this thread empties it as soon as it runs.
+constexpr int kLcmQueueCapacity = 512;
 class Inbox {
  public:
   Inbox(const std::string& url, std::size_t max_message_bytes, std::size_t max_queued_bytes)
@@ -91,7 +96,8 @@ class Inbox {
                      queued_bytes_ += m.data.size();
                      queue_.push_back(std::move(m));
                      ready_.notify_one();
-                   });
+                   },
+                   kLcmQueueCapacity);
     thread_ = std::thread([this] {
       try {
         while (!stop_) bus_.Handle(50);

@@ -41,13 +41,18 @@ void LcmBus::Publish(const std::string& channel, const std::vector<std::uint8_t>
   }
 }
 
-void LcmBus::Subscribe(const std::string& channel_regex, Handler handler) {
+void LcmBus::Subscribe(const std::string& channel_regex, Handler handler, int queue_capacity) {
+  if (queue_capacity < 0) {
+    Fail("LCM: queue capacity " + std::to_string(queue_capacity) + " for '" + channel_regex + "' is negative");
+  }
   auto sub = std::make_unique<Impl::Subscription>();
   sub->handler = std::move(handler);
-  if (lcm_subscribe(impl_->lcm.getUnderlyingLCM(), channel_regex.c_str(), &Impl::Subscription::Receive,
-                    sub.get()) == nullptr) {
+  lcm_subscription_t* subscription = lcm_subscribe(impl_->lcm.getUnderlyingLCM(), channel_regex.c_str(),
+                                                   &Impl::Subscription::Receive, sub.get());
+  if (subscription == nullptr) {
     Fail("LCM: cannot subscribe to '" + channel_regex + "' on '" + impl_->url + "'");
   }
+  lcm_subscription_set_queue_capacity(subscription, queue_capacity);
   impl_->subscriptions.push_back(std::move(sub));
 }
 

@@ -25,7 +25,11 @@ class LcmBus {
   using Handler = std::function<void(const std::string& channel, const std::uint8_t* data,
                                      std::size_t size, std::int64_t receive_utime)>;
   /// @param channel_regex LCM's channel regular expression ("ROMO_RIG_CLOUD.*").
-  void Subscribe(const std::string& channel_regex, Handler handler);
+  /// @param queue_capacity messages LCM holds for this subscription between its reader thread
+  ///        and Handle(); beyond that it drops them unseen. LCM's default is 30, less than one
+  ///        burst of a few frames of six rig clouds; 0 means unbounded.
+  void Subscribe(const std::string& channel_regex, Handler handler, int queue_capacity = kLcmDefaultQueueCapacity);
+  static constexpr int kLcmDefaultQueueCapacity = 30;
 
   /// Waits up to @p timeout_ms for one message and dispatches it.
   /// @return true when a message was handled, false on timeout.
