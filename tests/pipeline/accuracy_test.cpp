@@ -43,21 +43,21 @@ TEST(AccuracyTest, DefaultParkingSceneMeetsItsTargetsOrTodaysFloors) {
   // Targets met.
   EXPECT_LE(e.slot_yaw_err_deg, 3.0);
   EXPECT_EQ(e.narrow_reported_feasible, 0);
-  // Floors (measured with fragment merging: car P 0.616 R 0.362, pedestrian P 0.773 R 0.607,
-  // centre 0.220 m, slot 31/32 at 0.227 m). About 5 sightings of 300 (cars) and 200 (pedestrians)
-  // of margin.
-  EXPECT_GE(e.car.recall(), 0.34);
-  EXPECT_GE(e.car.precision(), 0.59);
+  // Floors (measured with lone faces read as such: car P 0.628 R 0.522, pedestrian P 0.881
+  // R 0.602, centre 0.218 m, slot 31/32 at 0.223 m). About 5 sightings of 300 (cars) and 200
+  // (pedestrians) of margin.
+  EXPECT_GE(e.car.recall(), 0.50);
+  EXPECT_GE(e.car.precision(), 0.60);
   EXPECT_GE(e.pedestrian.recall(), 0.58);
-  EXPECT_GE(e.pedestrian.precision(), 0.74);
+  EXPECT_GE(e.pedestrian.precision(), 0.85);
   EXPECT_LE(e.box_center_err_m_median, 0.245);
   EXPECT_GE(e.slot_found_frames, e.slot_visible_frames - 2);
   EXPECT_LE(e.slot_center_err_m, 0.26);
   // Hidden objects (about 40 car and 25 pedestrian sightings) are neither missed nor found there.
   EXPECT_LT(e.car_visible.truths, e.car.truths);
   EXPECT_GE(e.car_visible.recall(), e.car.recall());
-  EXPECT_GE(e.car_visible.recall(), 0.40);
-  EXPECT_GE(e.pedestrian_visible.recall(), 0.66);
+  EXPECT_GE(e.car_visible.recall(), 0.56);
+  EXPECT_GE(e.pedestrian_visible.recall(), 0.63);
 }
 
 }  // namespace

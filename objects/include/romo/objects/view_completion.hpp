@@ -22,6 +22,16 @@ struct ViewCompletionParams {
   /// (the hidden depth says nothing): the one needing the least completion wins (a pedestrian
   /// seen from the front is not completed into a cyclist).
   double ambiguity_ratio = 1.5;
+  /// A footprint this thin across one axis (and at most face_max_aspect of the other) is one
+  /// face of an object: its depth is hidden whatever the angle it is seen at, up to
+  /// face_max_obliquity_deg off its normal (a car's rear seen obliquely by a side camera, its
+  /// side hidden by the next car, is 1.8 m wide and 0.2 m deep with the sight line along its width).
+  double face_max_thickness_m = 0.5;
+  double face_max_aspect = 0.35;
+  double face_max_obliquity_deg = 75.0;
+  /// A class explains a lone face only with at least this score (stricter than the atlas's
+  /// min_score): a narrow face is as well two people one behind the other along the sight line.
+  double face_min_score = 0.3;
 };
 
 struct ViewedBox {
