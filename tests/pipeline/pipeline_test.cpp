@@ -115,6 +115,22 @@ TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   }
 }
 
+TEST(PipelineTest, OutOfRangeFaceReadingIsAClearError) {
+  PipelineParams params;
+  params.completion.face_max_obliquity_deg = 90.0;  // a face seen edge-on shows nothing
+  try {
+    params.Validate();
+    FAIL() << "no error";
+  } catch (const romo::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("obliquity 90"), std::string::npos) << e.what();
+  }
+  params.completion.face_max_obliquity_deg = 75.0;
+  params.completion.face_min_score = -0.1;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.completion.face_min_score = 0.3;
+  EXPECT_NO_THROW(params.Validate());
+}
+
 TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   romo::test::ScratchDir dir;
   const auto res = romo::test::RunRomo("run --frames 2 --scale 0.25 --no-pictures --out " + dir.path());

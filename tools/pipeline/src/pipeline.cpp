@@ -123,6 +123,15 @@ void PipelineParams::Validate() const {
     Fail("pipeline: completion.truncation_angle_deg must be in [0, 45), got " +
          std::to_string(completion.truncation_angle_deg));
   }
+  const auto& c = completion;
+  if (!(c.face_max_thickness_m >= 0 && c.face_max_aspect >= 0 && c.face_max_aspect <= 1 &&
+        c.face_max_obliquity_deg >= 0 && c.face_max_obliquity_deg < 90 && c.face_min_score >= 0 &&
+        c.face_min_score <= 1)) {
+    Fail("pipeline: completion.face_* out of range (thickness " + std::to_string(c.face_max_thickness_m) +
+         " m >= 0, aspect " + std::to_string(c.face_max_aspect) + " in [0, 1], obliquity " +
+         std::to_string(c.face_max_obliquity_deg) + " deg in [0, 90), min score " +
+         std::to_string(c.face_min_score) + " in [0, 1])");
+  }
   sgm.Validate();
   fusion.Validate();
   ground.Validate();
