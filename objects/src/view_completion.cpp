@@ -23,6 +23,15 @@ double ExtentCost(const SizePrior& prior, double x, bool truncated) {
   return z * z;
 }
 
+// The box's footprint axes (col(0) along its length), its extents along them, and the unit line
+// of sight from the viewer (zero when too near to have one).
+struct Footprint {
+  Eigen::Vector2d axis[2];
+  double extent[2];
+  Eigen::Vector2d center;
+  Eigen::Vector2d sight = Eigen::Vector2d::Zero();
+};
+
 // One reading of which footprint axis shows only its near face (-1: none), with the extents
 // and near face that follow from it.
 struct Reading {
@@ -30,6 +39,7 @@ struct Reading {
   double extent[2] = {0.0, 0.0};  ///< the truncated one less the depth noise
   double near_face = 0.0;         ///< along the truncated axis: where the seen surface most likely is
   double away = 1.0;              ///< +-1: the truncated axis's direction away from the viewer
+  bool lone_face = false;         ///< read as one face, whatever the sight line's angle
 };
 
 // How well a class explains a reading (score) and that times its prior (weight, which ranks).
@@ -38,8 +48,119 @@ struct Candidate {
   double weight;
   int class_index;
   int length_axis;
-  int reading;
+  const Reading* reading;
 };
+
+Reading ReadTruncated(const Footprint& f, int truncated_axis, double depth_spread_m) {
+  Reading r;
+  r.truncated_axis = truncated_axis;
+  r.extent[0] = f.extent[0];
+  r.extent[1] = f.extent[1];
+  if (truncated_axis < 0) return r;
+  const Eigen::Vector2d& a = f.axis[truncated_axis];
+  r.away = a.dot(f.sight) >= 0 ? 1.0 : -1.0;
+  const double spread = std::min(depth_spread_m, f.extent[truncated_axis]);
+  r.near_face = a.dot(f.center) - r.away * 0.5 * f.extent[truncated_axis] + r.away * 0.5 * spread;
+  r.extent[truncated_axis] -= spread;
+  return r;
+}
+
+// Which footprint axis only shows its near face: the one nearest the line of sight, if near
+// enough; and for a lone face (thin across one axis) also its normal, whatever the angle. Both
+// readings compete: two people one behind the other along the sight line look like a face seen
+// at a grazing angle, and the classes' sizes tell which reading explains the box.
+std::vector<Reading> Readings(const Footprint& f, const ViewCompletionParams& params, double depth_spread_m) {
+  std::vector<Reading> readings;
+  if (!f.sight.isZero()) {
+    const double c[2] = {std::abs(f.axis[0].dot(f.sight)), std::abs(f.axis[1].dot(f.sight))};
+    if (std::max(c[0], c[1]) >= std::cos(params.truncation_angle_deg * kPi / 180.0)) {
+      readings.push_back(ReadTruncated(f, c[0] >= c[1] ? 0 : 1, depth_spread_m));
+    }
+    const int thin = f.extent[0] <= f.extent[1] ? 0 : 1;
+    const bool face = f.extent[thin] <= params.face_max_thickness_m &&
+                      f.extent[thin] <= params.face_max_aspect * f.extent[1 - thin] &&
+                      c[thin] >= std::cos(params.face_max_obliquity_deg * kPi / 180.0);
+    if (face && (readings.empty() || readings.front().truncated_axis != thin)) {
+      readings.push_back(ReadTruncated(f, thin, depth_spread_m));
+      readings.back().lone_face = true;
+    }
+  }
+  if (readings.empty()) readings.push_back(ReadTruncated(f, -1, depth_spread_m));
+  return readings;
+}
+
+// Every class with priors under every reading when @p only_class < 0, else only that class.
+std::vector<Candidate> Candidates(const Atlas& atlas, double height_m, const std::vector<Reading>& readings,
+                                  const ViewCompletionParams& params, int only_class) {
+  std::vector<Candidate> candidates;
+  for (std::size_t c = 0; c < atlas.classes().size(); ++c) {
+    const ObjectClass& cls = atlas.classes()[c];
+    if (!cls.has_priors || (only_class >= 0 && static_cast<int>(c) != only_class)) continue;
+    const double h = ExtentCost(cls.height, height_m, false);
+    if (h < 0) continue;
+    for (const Reading& r : readings) {
+      for (int length_axis = 0; length_axis < 2; ++length_axis) {
+        const int width_axis = 1 - length_axis;
+        const double l = ExtentCost(cls.length, r.extent[length_axis], r.truncated_axis == length_axis);
+        const double w = ExtentCost(cls.width, r.extent[width_axis], r.truncated_axis == width_axis);
+        if (l < 0 || w < 0) continue;
+        const double score = std::exp(-0.5 * (l + w + h));
+        if (r.lone_face && score < params.face_min_score) continue;
+        candidates.push_back({score, score * cls.prior, static_cast<int>(c), length_axis, &r});
+      }
+    }
+  }
+  return candidates;
+}
+
+// The class's mean extent along the candidate reading's truncated axis.
+double CompletedExtent(const Atlas& atlas, const Candidate& k) {
+  const ObjectClass& cls = atlas.classes()[static_cast<std::size_t>(k.class_index)];
+  return k.length_axis == k.reading->truncated_axis ? cls.length.mean_m : cls.width.mean_m;
+}
+
+// The heaviest candidate; with a truncated extent the hidden depth says nothing, so of the
+// classes explaining the same reading about as well, the one needing the least completion.
+const Candidate* Choose(const Atlas& atlas, const std::vector<Candidate>& candidates,
+                        const ViewCompletionParams& params) {
+  const Candidate* best = nullptr;
+  for (const Candidate& k : candidates) {
+    if (best == nullptr || k.weight > best->weight) best = &k;
+  }
+  if (best == nullptr || best->reading->truncated_axis < 0) return best;
+  const Candidate* least = best;
+  for (const Candidate& k : candidates) {
+    if (k.reading == best->reading && k.weight * params.ambiguity_ratio >= best->weight &&
+        CompletedExtent(atlas, k) < CompletedExtent(atlas, *least)) {
+      least = &k;
+    }
+  }
+  return least;
+}
+
+// @p box grown to @p completed along @p r's truncated axis, away from the viewer from the near
+// face: the side that was seen keeps its place.
+Box3 Completed(const Box3& box, const Footprint& f, const Reading& r, double completed) {
+  Box3 out = box;
+  const Eigen::Vector2d& a = f.axis[r.truncated_axis];
+  const Eigen::Vector2d shift = a * (r.near_face + r.away * 0.5 * completed - a.dot(f.center));
+  out.center.x() += static_cast<float>(shift.x());
+  out.center.y() += static_cast<float>(shift.y());
+  out.size[r.truncated_axis] = static_cast<float>(completed);
+  if (out.size.y() > out.size.x()) {
+    // Keep the box's convention (axes.col(0) along the length) after the length changed axis.
+    std::swap(out.size.x(), out.size.y());
+    out.yaw_rad = static_cast<float>(std::remainder(box.yaw_rad + kPi / 2, kPi));
+    Eigen::Vector3f length_dir = out.axes.col(1), width_dir = -out.axes.col(0);
+    if (std::cos(out.yaw_rad) * length_dir.x() + std::sin(out.yaw_rad) * length_dir.y() < 0) {
+      length_dir = -length_dir;  // the heading wrapped by pi; turning both keeps the frame right-handed
+      width_dir = -width_dir;
+    }
+    out.axes.col(0) = length_dir;
+    out.axes.col(1) = width_dir;
+  }
+  return out;
+}
 
 // Every class with priors competes when @p only_class < 0, else only that one.
 ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
@@ -54,89 +175,18 @@ ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& v
       << box.size.transpose() << ", yaw " << box.yaw_rad << ") or viewer (" << viewer_xy.transpose() << ")";
     Fail(m.str());
   }
-  const Eigen::Vector2d axis[2] = {{std::cos(box.yaw_rad), std::sin(box.yaw_rad)},
-                                   {-std::sin(box.yaw_rad), std::cos(box.yaw_rad)}};
-  const double extent[2] = {box.size.x(), box.size.y()};
-  Eigen::Vector2d sight = (box.center.head<2>() - viewer_xy).cast<double>();
-  const double range = sight.norm();
-  auto reading = [&](int truncated_axis) {
-    Reading r;
-    r.truncated_axis = truncated_axis;
-    r.extent[0] = extent[0];
-    r.extent[1] = extent[1];
-    if (truncated_axis < 0) return r;
-    const Eigen::Vector2d a = axis[truncated_axis];
-    r.away = a.dot(sight) >= 0 ? 1.0 : -1.0;
-    const double spread = std::min(depth_spread_m, extent[truncated_axis]);
-    r.near_face = a.dot(box.center.head<2>().cast<double>()) - r.away * 0.5 * extent[truncated_axis] +
-                  r.away * 0.5 * spread;
-    r.extent[truncated_axis] -= spread;
-    return r;
-  };
-  // Which footprint axis only shows its near face: the one nearest the line of sight, if near
-  // enough; and for a lone face (thin across one axis) also its normal, whatever the angle. Both
-  // readings compete: two people one behind the other along the sight line look like a face seen
-  // at a grazing angle, and the classes' sizes tell which reading explains the box.
-  std::vector<Reading> readings;
-  int face_reading = -1;  // index of the lone-face reading, if any
-  if (range >= params.min_range_m) {
-    sight /= range;
-    const double c[2] = {std::abs(axis[0].dot(sight)), std::abs(axis[1].dot(sight))};
-    if (std::max(c[0], c[1]) >= std::cos(params.truncation_angle_deg * kPi / 180.0)) {
-      readings.push_back(reading(c[0] >= c[1] ? 0 : 1));
-    }
-    const int thin = extent[0] <= extent[1] ? 0 : 1;
-    const bool face = extent[thin] <= params.face_max_thickness_m &&
-                      extent[thin] <= params.face_max_aspect * extent[1 - thin] &&
-                      c[thin] >= std::cos(params.face_max_obliquity_deg * kPi / 180.0);
-    if (face && (readings.empty() || readings.front().truncated_axis != thin)) {
-      face_reading = static_cast<int>(readings.size());
-      readings.push_back(reading(thin));
-    }
-  }
-  if (readings.empty()) readings.push_back(reading(-1));
+  Footprint f;
+  f.axis[0] = {std::cos(box.yaw_rad), std::sin(box.yaw_rad)};
+  f.axis[1] = {-std::sin(box.yaw_rad), std::cos(box.yaw_rad)};
+  f.extent[0] = box.size.x();
+  f.extent[1] = box.size.y();
+  f.center = box.center.head<2>().cast<double>();
+  const Eigen::Vector2d sight = f.center - viewer_xy.cast<double>();
+  if (sight.norm() >= params.min_range_m) f.sight = sight.normalized();
 
-  std::vector<Candidate> candidates;
-  for (std::size_t c = 0; c < atlas.classes().size(); ++c) {
-    const ObjectClass& cls = atlas.classes()[c];
-    if (!cls.has_priors || (only_class >= 0 && static_cast<int>(c) != only_class)) continue;
-    const double h = ExtentCost(cls.height, box.size.z(), false);
-    if (h < 0) continue;
-    for (std::size_t k = 0; k < readings.size(); ++k) {
-      const Reading& r = readings[k];
-      for (int length_axis = 0; length_axis < 2; ++length_axis) {
-        const int width_axis = 1 - length_axis;
-        const double l = ExtentCost(cls.length, r.extent[length_axis], r.truncated_axis == length_axis);
-        const double w = ExtentCost(cls.width, r.extent[width_axis], r.truncated_axis == width_axis);
-        if (l < 0 || w < 0) continue;
-        const double score = std::exp(-0.5 * (l + w + h));
-        if (static_cast<int>(k) == face_reading && score < params.face_min_score) continue;
-        candidates.push_back({score, score * cls.prior, static_cast<int>(c), length_axis, static_cast<int>(k)});
-      }
-    }
-  }
-  const Candidate* best = nullptr;
-  for (const Candidate& k : candidates) {
-    if (best == nullptr || k.weight > best->weight) best = &k;
-  }
-  auto completed_extent = [&](const Candidate& k) {
-    const ObjectClass& cls = atlas.classes()[static_cast<std::size_t>(k.class_index)];
-    return k.length_axis == readings[static_cast<std::size_t>(k.reading)].truncated_axis ? cls.length.mean_m
-                                                                                        : cls.width.mean_m;
-  };
-  if (best != nullptr && readings[static_cast<std::size_t>(best->reading)].truncated_axis >= 0) {
-    // With a truncated extent the hidden depth says nothing: of the classes explaining the same
-    // reading about as well, the one needing the least completion wins.
-    const Candidate* least = best;
-    for (const Candidate& k : candidates) {
-      if (k.reading == best->reading && k.weight * params.ambiguity_ratio >= best->weight &&
-          completed_extent(k) < completed_extent(*least)) {
-        least = &k;
-      }
-    }
-    best = least;
-  }
-
+  const std::vector<Reading> readings = Readings(f, params, depth_spread_m);
+  const std::vector<Candidate> candidates = Candidates(atlas, box.size.z(), readings, params, only_class);
+  const Candidate* best = Choose(atlas, candidates, params);
   ViewedBox out;
   out.box = box;
   if (best == nullptr || best->score < atlas.min_score()) {
@@ -144,30 +194,10 @@ ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& v
     return out;
   }
   out.classification = {best->class_index, best->score};
-  const Reading& r = readings[static_cast<std::size_t>(best->reading)];
+  const Reading& r = *best->reading;
   if (r.truncated_axis < 0) return out;
-
-  const double completed = std::max(completed_extent(*best), r.extent[r.truncated_axis]);
-  // Grow away from the viewer from the near face: the side that was seen keeps its place.
-  const Eigen::Vector2d a = axis[r.truncated_axis];
-  const double along_now = a.dot(box.center.head<2>().cast<double>());
-  const Eigen::Vector2d shift = a * (r.near_face + r.away * 0.5 * completed - along_now);
-  out.box.center.x() += static_cast<float>(shift.x());
-  out.box.center.y() += static_cast<float>(shift.y());
-  out.box.size[r.truncated_axis] = static_cast<float>(completed);
+  out.box = Completed(box, f, r, std::max(CompletedExtent(atlas, *best), r.extent[r.truncated_axis]));
   out.completed = true;
-  if (out.box.size.y() > out.box.size.x()) {
-    // Keep the box's convention (axes.col(0) along the length) after the length changed axis.
-    std::swap(out.box.size.x(), out.box.size.y());
-    out.box.yaw_rad = static_cast<float>(std::remainder(box.yaw_rad + kPi / 2, kPi));
-    Eigen::Vector3f length_dir = out.box.axes.col(1), width_dir = -out.box.axes.col(0);
-    if (std::cos(out.box.yaw_rad) * length_dir.x() + std::sin(out.box.yaw_rad) * length_dir.y() < 0) {
-      length_dir = -length_dir;  // the heading wrapped by pi; turning both keeps the frame right-handed
-      width_dir = -width_dir;
-    }
-    out.box.axes.col(0) = length_dir;
-    out.box.axes.col(1) = width_dir;
-  }
   return out;
 }
 
