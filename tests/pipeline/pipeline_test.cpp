@@ -1,6 +1,7 @@
 // The pipeline after stereo on a synthetic 360 deg cloud, and `romo run` end to end (small).
 #include "romo/pipeline/pipeline.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 
@@ -135,7 +136,12 @@ TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
     // coasts: 2 s), then the ground where it stood comes into view.
     for (int k = 0; k < 4; ++k, t += 100'000'000) frames.push_back(pipe.ProcessClouds(t, k, {ParkedCarScene(t, true, false)}, std::nullopt, std::nullopt));
     for (int k = 4; k < 8; ++k, t += 1'000'000'000) frames.push_back(pipe.ProcessClouds(t, k, {ParkedCarScene(t, false, false)}, std::nullopt, std::nullopt));
-    frames.push_back(pipe.ProcessClouds(t, 8, {ParkedCarScene(t, false, true)}, std::nullopt, std::nullopt));
+    // Seen again under a new track (the first was deleted meanwhile), hidden again: listed once.
+    for (int k = 8; k < 12; ++k, t += 100'000'000) frames.push_back(pipe.ProcessClouds(t, k, {ParkedCarScene(t, true, false)}, std::nullopt, std::nullopt));
+    t += 3'000'000'000;
+    frames.push_back(pipe.ProcessClouds(t, 12, {ParkedCarScene(t, false, false)}, std::nullopt, std::nullopt));
+    t += 1'000'000'000;
+    frames.push_back(pipe.ProcessClouds(t, 13, {ParkedCarScene(t, false, true)}, std::nullopt, std::nullopt));
     return frames;
   };
   auto cars = [](const FrameResult& r) {
@@ -158,12 +164,70 @@ TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
     EXPECT_NEAR(hidden[0].center_m.x(), seen[0].center_m.x(), 0.05);
     EXPECT_NEAR(hidden[0].center_m.y(), seen[0].center_m.y(), 0.05);
   }
-  EXPECT_TRUE(cars(remembered[8]).empty()) << "the ground where it stood is in view: it has left";
+  const auto seen_again = cars(remembered[11]);
+  ASSERT_EQ(seen_again.size(), 1u);
+  EXPECT_NE(seen_again[0].track_id, seen[0].track_id) << "the first track should have been deleted";
+  const auto hidden_again = cars(remembered[12]);
+  ASSERT_EQ(hidden_again.size(), 1u) << "the same car remembered under both tracks";
+  EXPECT_EQ(hidden_again[0].track_id, seen_again[0].track_id);
+  EXPECT_TRUE(cars(remembered[13]).empty()) << "the ground where it stood is in view: it has left";
 
   PipelineParams forgetful;
   forgetful.parked_free_ground_points = 0;
   const std::vector<FrameResult> without = run(forgetful);
   EXPECT_TRUE(cars(without[7]).empty()) << "without the memory the track coasts 2 s at most";
+}
+
+// Ground, and people 0.45 m square and 1.7 m tall (surface points) at @p xs on the x axis ahead
+// of the front rig.
+RigInput PeopleAhead(const std::vector<float>& xs) {
+  RigInput in = SyntheticRig(1, 1000);  // ground only
+  in.rig_id = 0;
+  for (float cx : xs) {
+    for (float z = 0.05f; z <= 1.7f; z += 0.04f) {
+      for (float s = -0.225f; s <= 0.225f; s += 0.03f) {
+        in.cloud.PushBack({cx - 0.225f, s, z}, 0.01f, 50.f);
+        in.cloud.PushBack({cx + 0.225f, s, z}, 0.01f, 50.f);
+        in.cloud.PushBack({cx + s, -0.225f, z}, 0.01f, 50.f);
+        in.cloud.PushBack({cx + s, 0.225f, z}, 0.01f, 50.f);
+      }
+    }
+  }
+  return in;
+}
+
+TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto pedestrians = [](const FrameResult& r) {
+    std::vector<Eigen::Vector3d> out;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.class_name == "pedestrian") out.push_back(o.center_m);
+    }
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.x() < b.x(); });
+    return out;
+  };
+  // 0.6 m apart along the line of sight: 0.15 m between them, one voxel, so one blob 1.05 m long.
+  PipelineParams whole;
+  whole.tandem_min_length_m = 0.0;
+  const FrameResult one = Pipeline(calibration, whole).ProcessClouds(1000, 1, {PeopleAhead({5.f, 5.6f})},
+                                                                    std::nullopt, std::nullopt);
+  ASSERT_EQ(one.blobs.size(), 1u) << "the two must touch for this test";
+  EXPECT_LE(pedestrians(one).size(), 1u);
+
+  const FrameResult two = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1, {PeopleAhead({5.f, 5.6f})}, std::nullopt, std::nullopt);
+  const auto people = pedestrians(two);
+  ASSERT_EQ(people.size(), 2u);
+  // Each half's box spans its person's points (the voxel leaf bounds the error).
+  EXPECT_NEAR(people[0].x(), 5.0, kBoxCentreTolM);
+  EXPECT_NEAR(people[1].x(), 5.6, kBoxCentreTolM);
+  EXPECT_NEAR(people[0].y(), 0.0, kBoxCentreTolM);
+  EXPECT_NEAR(people[1].y(), 0.0, kBoxCentreTolM);
+
+  // One person is never split.
+  const FrameResult single = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1, {PeopleAhead({5.f})}, std::nullopt, std::nullopt);
+  EXPECT_EQ(pedestrians(single).size(), 1u);
 }
 
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {

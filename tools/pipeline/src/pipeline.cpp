@@ -192,6 +192,13 @@ class Pipeline::Impl {
       }
       ParkedCar car{detections[static_cast<std::size_t>(i)], tr.id};
       car.box.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
+      // The same car remembered under an earlier track (an ID switch, or a replay looping back)
+      // is replaced, not listed twice.
+      for (auto it = parked.begin(); it != parked.end();) {
+        const bool same_car = it->first != tr.id && (it->second.box.xy_m - car.box.xy_m).norm() <
+                                                        0.5 * std::max(it->second.box.length_m, car.box.length_m);
+        it = same_car ? parked.erase(it) : std::next(it);
+      }
       parked[tr.id] = car;
     }
   }
@@ -292,6 +299,58 @@ class Pipeline::Impl {
     }
   }
 
+  // Splits pedestrian-tall blobs too long for one person (two people walking one behind the
+  // other along the sight line) in two along their length, when both halves are pedestrians.
+  void SplitTandems(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                    std::vector<Seen>* seen) const {
+    if (params.tandem_min_length_m <= 0.0 || pedestrian_class < 0) return;
+    const std::size_t n = r.boxes.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Seen& whole = (*seen)[i];
+      const objects::Box3& box = r.boxes[i];
+      // Pedestrian-tall and -narrow whatever it was classed as (a pair reads as a cyclist end-on).
+      const auto& ped = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
+      if (!whole.on_ground || box.size.x() - whole.depth_spread_m < params.tandem_min_length_m ||
+          !ped.height.Contains(box.size.z()) || box.size.y() > ped.width.max_m) {
+        continue;
+      }
+      // Two clusters along the length axis (1-D 2-means from the ends).
+      const Eigen::Vector3f axis = box.axes.col(0);
+      std::vector<float> t;
+      t.reserve(r.blobs[i].size());
+      for (int k : r.blobs[i]) t.push_back(axis.dot(r.cloud.xyz.col(k)));
+      float a = *std::min_element(t.begin(), t.end()), b = *std::max_element(t.begin(), t.end());
+      for (int it = 0; it < 10; ++it) {
+        double sa = 0, sb = 0;
+        int na = 0, nb = 0;
+        for (float v : t) (std::abs(v - a) <= std::abs(v - b) ? (sa += v, ++na) : (sb += v, ++nb));
+        if (na == 0 || nb == 0) break;
+        a = static_cast<float>(sa / na);
+        b = static_cast<float>(sb / nb);
+      }
+      std::vector<int> halves[2];
+      for (std::size_t k = 0; k < t.size(); ++k) halves[std::abs(t[k] - a) <= std::abs(t[k] - b) ? 0 : 1].push_back(r.blobs[i][k]);
+      if (halves[0].size() < static_cast<std::size_t>(params.segmentation.min_blob_points) ||
+          halves[1].size() < static_cast<std::size_t>(params.segmentation.min_blob_points)) continue;
+      objects::Box3 boxes[2];
+      Seen parts[2];
+      bool both = true;
+      for (int h = 0; h < 2 && both; ++h) {
+        boxes[h] = FitBox(r.cloud, halves[h], up, std::nullopt, (*viewers)[i]);
+        parts[h] = See(r, boxes[h], halves[h], up, (*viewers)[i]);
+        both = parts[h].viewed.classification.class_index == pedestrian_class;
+      }
+      if (!both) continue;
+      r.boxes[i] = boxes[0];
+      r.blobs[i] = std::move(halves[0]);
+      (*seen)[i] = parts[0];
+      r.boxes.push_back(boxes[1]);
+      r.blobs.push_back(std::move(halves[1]));
+      seen->push_back(parts[1]);
+      viewers->push_back((*viewers)[i]);
+    }
+  }
+
   static stereo::StereoParams StereoParamsOf(const PipelineParams& p) {
     stereo::StereoParams sp;
     sp.disparity_size = p.disparity_size;
@@ -307,6 +366,7 @@ class Pipeline::Impl {
   objects::Atlas atlas;
   std::vector<int> merge_classes;  // fragment_merge_classes as atlas indices
   int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
+  int pedestrian_class = atlas.Find("pedestrian");
   std::map<int, ParkedCar> parked;    // by track id
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
@@ -511,6 +571,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   std::vector<Pipeline::Impl::Seen> seen;
   for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], up, viewers[i]));
   s.MergeFragments(r, up, &viewers, &seen);
+  s.SplitTandems(r, up, &viewers, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {

@@ -56,6 +56,11 @@ struct PipelineParams {
   /// fragment, and merging would hide a person beside a car's front); 0 turns merging off.
   double fragment_merge_gap_m = 1.0;
   std::vector<std::string> fragment_merge_classes = {"car"};
+  /// A pedestrian-tall blob at least this long (less depth noise) is split in two along its
+  /// length when both halves are pedestrians: two people walking one behind the other along the
+  /// sight line stay one blob (0.6 m apart on the simulated scene: 56 of 196 pedestrian sightings
+  /// lost). 0.9 m is longer than one person's stride (Atlas pedestrian mean + 1.2 sigma). 0 = off.
+  double tandem_min_length_m = 0.9;
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
   /// Parked cars are remembered in the world frame while the ground under them stays unseen: a
