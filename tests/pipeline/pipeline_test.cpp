@@ -2,6 +2,7 @@
 #include "romo/pipeline/pipeline.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -242,7 +243,7 @@ TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   }
 }
 
-TEST(PipelineTest, OutOfRangeFaceReadingIsAClearError) {
+TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   PipelineParams params;
   params.completion.face_max_obliquity_deg = 90.0;  // a face seen edge-on shows nothing
   try {
@@ -256,6 +257,11 @@ TEST(PipelineTest, OutOfRangeFaceReadingIsAClearError) {
   EXPECT_THROW(params.Validate(), romo::Error);
   params.completion.face_min_score = 0.3;
   EXPECT_NO_THROW(params.Validate());
+  params.parked_free_ground_points = -1;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_free_ground_points = 20;
+  params.tandem_min_length_m = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
 }
 
 TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {

@@ -1,6 +1,7 @@
 #include "romo/pipeline/pipeline.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -83,6 +84,30 @@ int PointsInsideFootprint(const PointCloud& cloud, const std::vector<int>& indic
   return inside;
 }
 
+// @p blob in two along @p axis: 1-D 2-means started from its ends.
+std::array<std::vector<int>, 2> SplitAlong(const PointCloud& cloud, const std::vector<int>& blob,
+                                           const Eigen::Vector3f& axis) {
+  std::vector<float> along;
+  along.reserve(blob.size());
+  for (int i : blob) along.push_back(axis.dot(cloud.xyz.col(i)));
+  const auto [lo, hi] = std::minmax_element(along.begin(), along.end());
+  float mean[2] = {*lo, *hi};
+  auto side = [&](float v) { return std::abs(v - mean[0]) <= std::abs(v - mean[1]) ? 0 : 1; };
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    double sum[2] = {0.0, 0.0};
+    int count[2] = {0, 0};
+    for (float v : along) {
+      sum[side(v)] += v;
+      ++count[side(v)];
+    }
+    if (count[0] == 0 || count[1] == 0) break;
+    for (int k = 0; k < 2; ++k) mean[k] = static_cast<float>(sum[k] / count[k]);
+  }
+  std::array<std::vector<int>, 2> halves;
+  for (std::size_t k = 0; k < along.size(); ++k) halves[static_cast<std::size_t>(side(along[k]))].push_back(blob[k]);
+  return halves;
+}
+
 }  // namespace
 
 mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
@@ -137,6 +162,9 @@ void PipelineParams::Validate() const {
          " >= 0, speed " + std::to_string(parked_max_speed_mps) + " m/s >= 0, margin " +
          std::to_string(parked_footprint_margin_m) + " m >= 0, range " + std::to_string(parked_max_range_m) +
          " m > 0)");
+  }
+  if (!(tandem_min_length_m >= 0)) {
+    Fail("pipeline: tandem_min_length_m must be >= 0, got " + std::to_string(tandem_min_length_m));
   }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
@@ -314,22 +342,7 @@ class Pipeline::Impl {
           !ped.height.Contains(box.size.z()) || box.size.y() > ped.width.max_m) {
         continue;
       }
-      // Two clusters along the length axis (1-D 2-means from the ends).
-      const Eigen::Vector3f axis = box.axes.col(0);
-      std::vector<float> t;
-      t.reserve(r.blobs[i].size());
-      for (int k : r.blobs[i]) t.push_back(axis.dot(r.cloud.xyz.col(k)));
-      float a = *std::min_element(t.begin(), t.end()), b = *std::max_element(t.begin(), t.end());
-      for (int it = 0; it < 10; ++it) {
-        double sa = 0, sb = 0;
-        int na = 0, nb = 0;
-        for (float v : t) (std::abs(v - a) <= std::abs(v - b) ? (sa += v, ++na) : (sb += v, ++nb));
-        if (na == 0 || nb == 0) break;
-        a = static_cast<float>(sa / na);
-        b = static_cast<float>(sb / nb);
-      }
-      std::vector<int> halves[2];
-      for (std::size_t k = 0; k < t.size(); ++k) halves[std::abs(t[k] - a) <= std::abs(t[k] - b) ? 0 : 1].push_back(r.blobs[i][k]);
+      std::array<std::vector<int>, 2> halves = SplitAlong(r.cloud, r.blobs[i], box.axes.col(0));
       if (halves[0].size() < static_cast<std::size_t>(params.segmentation.min_blob_points) ||
           halves[1].size() < static_cast<std::size_t>(params.segmentation.min_blob_points)) continue;
       objects::Box3 boxes[2];
