@@ -202,12 +202,6 @@ class Pipeline::Impl {
     for (const std::string& name : p.fragment_merge_classes) merge_classes.push_back(atlas.Require(name));
   }
 
-  // A parked car as last seen (world frame), kept by its track id.
-  struct ParkedCar {
-    objects::Detection box;
-    int track_id = 0;
-  };
-
   // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
   void RememberParkedCars(const std::vector<objects::Track>& tracks, const std::vector<objects::Detection>& detections) {
     if (params.parked_free_ground_points <= 0 || car_class < 0) return;
@@ -218,26 +212,27 @@ class Pipeline::Impl {
           tr.velocity_mps.norm() > params.parked_max_speed_mps) {
         continue;
       }
-      ParkedCar car{detections[static_cast<std::size_t>(i)], tr.id};
-      car.box.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
+      objects::Detection car = detections[static_cast<std::size_t>(i)];
+      car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
       // The same car remembered under an earlier track (an ID switch, or a replay looping back)
       // is replaced, not listed twice.
       for (auto it = parked.begin(); it != parked.end();) {
-        const bool same_car = it->first != tr.id && (it->second.box.xy_m - car.box.xy_m).norm() <
-                                                        0.5 * std::max(it->second.box.length_m, car.box.length_m);
+        const bool same_car = it->first != tr.id && (it->second.xy_m - car.xy_m).norm() <
+                                                        0.5 * std::max(it->second.length_m, car.length_m);
         it = same_car ? parked.erase(it) : std::next(it);
       }
       parked[tr.id] = car;
     }
   }
 
-  // The remembered cars not among this frame's car obstacles while the ground under them stays
-  // unseen (world frame); the others are forgotten.
-  std::vector<ParkedCar> HiddenParkedCars(const FrameResult& r) {
-    std::vector<ParkedCar> hidden;
+  // The remembered cars (track id, world frame) not among this frame's car obstacles while the
+  // ground under them stays unseen; the others are forgotten.
+  std::vector<std::pair<int, objects::Detection>> HiddenParkedCars(const FrameResult& r) {
+    std::vector<std::pair<int, objects::Detection>> hidden;
     const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
     for (auto it = parked.begin(); it != parked.end();) {
-      const objects::Detection& d = it->second.box;
+      const objects::Detection& d = it->second;  // a car: only cars are remembered
+      const std::string& car_name = atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name;
       const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
       const double m = params.parked_footprint_margin_m;
       const bool ground_seen = PointsInsideFootprint(r.cloud, r.ground_indices, xy, d.yaw_rad - r.ego_world.yaw_rad,
@@ -249,15 +244,14 @@ class Pipeline::Impl {
       }
       bool seen_now = false;
       for (const auto& o : r.obstacles.obstacles) {
-        seen_now = seen_now || (o.class_name == CarName() && o.num_points > 0 &&
+        seen_now = seen_now || (o.class_name == car_name && o.num_points > 0 &&
                                 (o.track_id == it->first || (o.center_m.head<2>() - xy).norm() < 0.5 * d.length_m));
       }
-      if (!seen_now) hidden.push_back(it->second);
+      if (!seen_now) hidden.emplace_back(*it);
       ++it;
     }
     return hidden;
   }
-  const std::string& CarName() const { return atlas.classes()[static_cast<std::size_t>(std::max(car_class, 0))].name; }
 
   // A box as FitVerticalBox gives it, or along its de-noised heading when depth noise dominates.
   objects::Box3 FitBox(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& up,
@@ -332,12 +326,12 @@ class Pipeline::Impl {
   void SplitTandems(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
                     std::vector<Seen>* seen) const {
     if (params.tandem_min_length_m <= 0.0 || pedestrian_class < 0) return;
+    const objects::ObjectClass& ped = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
     const std::size_t n = r.boxes.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Seen& whole = (*seen)[i];
       const objects::Box3& box = r.boxes[i];
       // Pedestrian-tall and -narrow whatever it was classed as (a pair reads as a cyclist end-on).
-      const auto& ped = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
       if (!whole.on_ground || box.size.x() - whole.depth_spread_m < params.tandem_min_length_m ||
           !ped.height.Contains(box.size.z()) || box.size.y() > ped.width.max_m) {
         continue;
@@ -380,7 +374,7 @@ class Pipeline::Impl {
   std::vector<int> merge_classes;  // fragment_merge_classes as atlas indices
   int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
   int pedestrian_class = atlas.Find("pedestrian");
-  std::map<int, ParkedCar> parked;    // by track id
+  std::map<int, objects::Detection> parked;  // world frame, by track id
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
@@ -661,15 +655,22 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   std::vector<const objects::Track*> track_ptr(r.boxes.size(), nullptr);
   std::vector<std::vector<const objects::Track*>> merged_tracks(r.boxes.size());
   const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
-  auto track_obstacle = [&](const objects::Track& tr, int num_points) {
+  // A world-frame footprint (a track's or a remembered car's) as an obstacle in the vehicle frame.
+  auto footprint_obstacle = [&](int track_id, int class_index, double score, const Eigen::Vector2d& xy_world,
+                                double yaw_world, double length_m, double width_m, double height_m) {
     planning_iface::Obstacle o;
-    o.track_id = tr.id;
-    o.class_name = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].name;
-    o.score = static_cast<float>(tr.class_score);
-    const Eigen::Vector3d c = T_vehicle_world * Eigen::Vector3d(tr.xy_m.x(), tr.xy_m.y(), 0.0);
-    o.center_m = Eigen::Vector3d(c.x(), c.y(), tr.height_m / 2.0);
-    o.size_m = Eigen::Vector3d(tr.length_m, tr.width_m, tr.height_m);
-    o.yaw_rad = tr.yaw_rad - r.ego_world.yaw_rad;
+    o.track_id = track_id;
+    o.class_name = s.atlas.classes()[static_cast<std::size_t>(class_index)].name;
+    o.score = static_cast<float>(score);
+    const Eigen::Vector3d c = T_vehicle_world * Eigen::Vector3d(xy_world.x(), xy_world.y(), 0.0);
+    o.center_m = Eigen::Vector3d(c.x(), c.y(), height_m / 2.0);
+    o.size_m = Eigen::Vector3d(length_m, width_m, height_m);
+    o.yaw_rad = yaw_world - r.ego_world.yaw_rad;
+    return o;
+  };
+  auto track_obstacle = [&](const objects::Track& tr, int num_points) {
+    planning_iface::Obstacle o = footprint_obstacle(tr.id, tr.class_index, tr.class_score, tr.xy_m, tr.yaw_rad,
+                                                    tr.length_m, tr.width_m, tr.height_m);
     o.velocity_mps = Rotate(tr.velocity_mps, -r.ego_world.yaw_rad);
     o.num_points = num_points;
     return o;
@@ -708,44 +709,31 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   }
 
   s.RememberParkedCars(r.tracks, detections);
-  const std::vector<Pipeline::Impl::ParkedCar> hidden_cars = s.HiddenParkedCars(r);
-  for (const auto& car : hidden_cars) {
-    const objects::Detection& d = car.box;
-    planning_iface::Obstacle o;
-    o.track_id = car.track_id;
-    o.class_name = s.CarName();
-    o.score = static_cast<float>(d.classification.score);
-    const Eigen::Vector3d c = T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0);
-    o.center_m = Eigen::Vector3d(c.x(), c.y(), d.height_m / 2.0);
-    o.size_m = Eigen::Vector3d(d.length_m, d.width_m, d.height_m);
-    o.yaw_rad = d.yaw_rad - r.ego_world.yaw_rad;
-    r.obstacles.obstacles.push_back(o);  // num_points 0: not measured now
+  const std::vector<std::pair<int, objects::Detection>> hidden_cars = s.HiddenParkedCars(r);
+  for (const auto& [id, d] : hidden_cars) {
+    // num_points 0: not measured now
+    r.obstacles.obstacles.push_back(footprint_obstacle(id, d.classification.class_index, d.classification.score,
+                                                       d.xy_m, d.yaw_rad, d.length_m, d.width_m, d.height_m));
   }
 
   // Stage: parking slots from the parked cars (world frame, filtered over frames).
   t0 = Clock::now();
   std::vector<planning_iface::GroundBox> cars;
-  for (std::size_t i = 0; i < detections.size(); ++i) {
-    if (r.box_classes[i] != "car") continue;
+  auto add_car = [&](const objects::Detection& d, int id) {
     planning_iface::GroundBox b;
-    b.center_m = detections[i].xy_m;
-    b.yaw_rad = detections[i].yaw_rad;
-    b.length_m = detections[i].length_m;
-    b.width_m = detections[i].width_m;
-    b.id = track_of[i];
+    b.center_m = d.xy_m;
+    b.yaw_rad = d.yaw_rad;
+    b.length_m = d.length_m;
+    b.width_m = d.width_m;
+    b.id = id;
     cars.push_back(b);
+  };
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    if (r.box_classes[i] == "car") add_car(detections[i], track_of[i]);
   }
   // Neighbours hidden now (behind the row in front, or beside the vehicle during the entry) still
   // bound the bay.
-  for (const auto& car : hidden_cars) {
-    planning_iface::GroundBox b;
-    b.center_m = car.box.xy_m;
-    b.yaw_rad = car.box.yaw_rad;
-    b.length_m = car.box.length_m;
-    b.width_m = car.box.width_m;
-    b.id = car.track_id;
-    cars.push_back(b);
-  }
+  for (const auto& [id, d] : hidden_cars) add_car(d, id);
   r.slots.stamp_ns = stamp_ns;
   r.slots.frame_sequence = frame_sequence;
   r.slots.ego_world = r.ego_world;
