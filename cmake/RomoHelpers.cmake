@@ -29,10 +29,11 @@ function(romo_add_library module)
   endif()
 endfunction()
 
-# romo_add_gtest(<name> SOURCES ... LIBS ... [LABELS ...])
-# One executable per test file, cases discovered into CTest with the given labels.
+# romo_add_gtest(<name> SOURCES ... LIBS ... [LABELS ...] [TIMEOUT s] [SERIAL])
+# One executable per test file, cases discovered into CTest with the given labels; SERIAL runs
+# them with nothing beside them (measurements that other processes would disturb).
 function(romo_add_gtest name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
@@ -41,9 +42,13 @@ function(romo_add_gtest name)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} romo_test_support GTest::gtest GTest::gtest_main)
+  set(serial FALSE)
+  if(ARG_SERIAL)
+    set(serial TRUE)
+  endif()
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 120
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT})
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} RUN_SERIAL ${serial})
   # Data, source and romo binary paths are compiled into romo_test_support (environment
   # variables of the same names override them): gtest_discover_tests flattens list-valued
   # ENVIRONMENT properties, so only the first entry would survive.
