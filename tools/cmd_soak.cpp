@@ -41,7 +41,37 @@ struct Sample {
   double rss_mb = 0.0;
   double latency_ms = 0.0;  // the pipeline's own end-to-end time for the frame (wall)
   double cpu_ms = 0.0;      // process CPU time spent on the frame (all threads)
+  double tracks = 0.0;      // tracks the pipeline holds after the frame (live and coasting)
+  std::int64_t loop = 0;    // times the recording had started over when the frame came out
 };
+
+// Mean tracks held per frame over the first and the last loop wholly inside the measured window:
+// every loop replays the same frames, so state that is never pruned shows as a difference that no
+// host load can cause (unlike the time slopes).
+struct TracksPerLoop {
+  double first = 0.0, last = 0.0;
+  std::int64_t loops_compared = 0;
+};
+
+TracksPerLoop CompareLoops(const std::vector<Sample>& measured) {
+  TracksPerLoop result;
+  if (measured.empty()) return result;
+  // The first and last loops seen may be cut by the warm-up and the end of the run.
+  const std::int64_t first = measured.front().loop + 1, last = measured.back().loop - 1;
+  if (last < first) return result;
+  auto mean_of = [&](std::int64_t loop) {
+    double sum = 0.0;
+    int n = 0;
+    for (const auto& s : measured) {
+      if (s.loop == loop) sum += s.tracks, ++n;
+    }
+    return n > 0 ? sum / n : 0.0;
+  };
+  result.first = mean_of(first);
+  result.last = mean_of(last);
+  result.loops_compared = last - first + 1;
+  return result;
+}
 
 // Resident set size from /proc/self/status ("VmRSS:   123456 kB"), in MB (1e6 bytes).
 double ResidentMb() {
@@ -155,6 +185,8 @@ void Soak(const SoakOptions& o) {
         const double cpu_now = ProcessCpuMs();
         s.cpu_ms = cpu_now - cpu_before;
         cpu_before = cpu_now;
+        s.tracks = static_cast<double>(r.tracks.size());
+        s.loop = looped.loops();
         samples.push_back(s);
         char text[96];
         std::snprintf(text, sizeof text, "%.0f s, RSS %.1f MB, %.0f ms", s.t_s, s.rss_mb, s.latency_ms);
@@ -173,6 +205,7 @@ void Soak(const SoakOptions& o) {
   const Fit rss = LeastSquares(measured, &Sample::rss_mb);
   const Fit latency = LeastSquares(measured, &Sample::latency_ms);
   const Fit cpu = LeastSquares(measured, &Sample::cpu_ms);
+  const TracksPerLoop tracks = CompareLoops(measured);
   std::vector<double> latencies, rss_values;
   for (const auto& s : measured) {
     latencies.push_back(s.latency_ms);
@@ -182,8 +215,11 @@ void Soak(const SoakOptions& o) {
 
   {
     std::ofstream csv(o.out_dir + "/soak.csv");
-    csv << "t_s,rss_mb,latency_ms,cpu_ms\n";
-    for (const auto& s : samples) csv << s.t_s << ',' << s.rss_mb << ',' << s.latency_ms << ',' << s.cpu_ms << '\n';
+    csv << "t_s,rss_mb,latency_ms,cpu_ms,tracks,loop\n";
+    for (const auto& s : samples) {
+      csv << s.t_s << ',' << s.rss_mb << ',' << s.latency_ms << ',' << s.cpu_ms << ',' << s.tracks << ',' << s.loop
+          << '\n';
+    }
   }
   {
     std::ofstream json(o.out_dir + "/soak.json");
@@ -193,12 +229,14 @@ void Soak(const SoakOptions& o) {
                   "  \"frames_measured\": %zu,\n  \"loops\": %lld,\n  \"skipped_out_of_order\": %lld,\n"
                   "  \"rss_mb\": {\"first\": %.2f, \"last\": %.2f, \"max\": %.2f, \"mean\": %.2f, \"slope_mb_per_min\": %.4f},\n"
                   "  \"latency_ms\": {\"mean\": %.2f, \"p50\": %.2f, \"p95\": %.2f, \"slope_ms_per_min\": %.4f},\n"
-                  "  \"cpu_ms_per_frame\": {\"mean\": %.2f, \"slope_ms_per_min\": %.4f}\n}\n",
+                  "  \"cpu_ms_per_frame\": {\"mean\": %.2f, \"slope_ms_per_min\": %.4f},\n"
+                  "  \"tracks_per_frame\": {\"first_loop\": %.3f, \"last_loop\": %.3f, \"loops_compared\": %lld}\n}\n",
                   JsonEscape(o.log).c_str(), wall_s, o.warmup_s, static_cast<long long>(stats.frames), measured.size(),
                   static_cast<long long>(looped.loops()), static_cast<long long>(stats.skipped_out_of_order),
                   measured.front().rss_mb, measured.back().rss_mb,
                   *std::max_element(rss_values.begin(), rss_values.end()), rss.mean, rss.slope, latency.mean,
-                  Percentile(latencies, 0.5), Percentile(latencies, 0.95), latency.slope, cpu.mean, cpu.slope);
+                  Percentile(latencies, 0.5), Percentile(latencies, 0.95), latency.slope, cpu.mean, cpu.slope, tracks.first, tracks.last,
+                  static_cast<long long>(tracks.loops_compared));
     json << text;
   }
   cv::Mat plot(3 * 260 + 20, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
