@@ -43,21 +43,22 @@ TEST(AccuracyTest, DefaultParkingSceneMeetsItsTargetsOrTodaysFloors) {
   // Targets met.
   EXPECT_LE(e.slot_yaw_err_deg, 3.0);
   EXPECT_EQ(e.narrow_reported_feasible, 0);
-  // Floors (measured with lone faces read as such, hidden parked cars remembered and people in
-  // tandem split: car P 0.687 R 0.575, pedestrian P 0.855 R 0.724, centre 0.221 m, slot 31/32 at
-  // 0.218 m). About 5 sightings of 300 (cars) and 200 (pedestrians) of margin.
-  EXPECT_GE(e.car.recall(), 0.56);
-  EXPECT_GE(e.car.precision(), 0.67);
-  EXPECT_GE(e.pedestrian.recall(), 0.70);
-  EXPECT_GE(e.pedestrian.precision(), 0.83);
-  EXPECT_LE(e.box_center_err_m_median, 0.235);
+  // Floors (measured with lone faces read as such, hidden parked cars remembered, people in
+  // tandem split, coasting fragments no longer cars and walls framed by nearer cars unclassified:
+  // car P 0.924 R 0.565, pedestrian P 0.865 R 0.750, centre 0.226 m, slot 31/32 at 0.218 m).
+  // About 5 sightings of 300 (cars) and 200 (pedestrians) of margin.
+  EXPECT_GE(e.car.recall(), 0.55);
+  EXPECT_GE(e.car.precision(), 0.89);
+  EXPECT_GE(e.pedestrian.recall(), 0.72);
+  EXPECT_GE(e.pedestrian.precision(), 0.84);
+  EXPECT_LE(e.box_center_err_m_median, 0.24);
   EXPECT_GE(e.slot_found_frames, e.slot_visible_frames - 2);
   EXPECT_LE(e.slot_center_err_m, 0.24);
   // Hidden objects (about 40 car and 25 pedestrian sightings) are neither missed nor found there.
   EXPECT_LT(e.car_visible.truths, e.car.truths);
   EXPECT_GE(e.car_visible.recall(), e.car.recall());
-  EXPECT_GE(e.car_visible.recall(), 0.62);
-  EXPECT_GE(e.pedestrian_visible.recall(), 0.76);
+  EXPECT_GE(e.car_visible.recall(), 0.61);
+  EXPECT_GE(e.pedestrian_visible.recall(), 0.77);
 }
 
 }  // namespace

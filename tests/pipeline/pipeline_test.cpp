@@ -231,6 +231,55 @@ TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {
   EXPECT_EQ(pedestrians(single).size(), 1u);
 }
 
+// Ground all round for the front rig, and vertical faces 0.05..1.4 m high between the given end
+// points (vehicle frame, 3 cm apart), spread over +-0.3 m along x like stereo depth noise at 10 m.
+RigInput FacesAhead(const std::vector<std::pair<Eigen::Vector2f, Eigen::Vector2f>>& faces) {
+  RigInput in = SyntheticRig(1, 1000);  // ground only
+  in.rig_id = 0;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> depth_noise(-0.3f, 0.3f);
+  for (const auto& [a, b] : faces) {
+    const int steps = static_cast<int>((b - a).norm() / 0.03f);
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2f xy = a + (b - a) * (static_cast<float>(k) / static_cast<float>(steps));
+      for (float z = 0.05f; z <= 1.4f; z += 0.03f) {
+        in.cloud.PushBack({xy.x() + depth_noise(rng), xy.y(), z}, 0.15f, 50.f);
+      }
+    }
+  }
+  return in;
+}
+
+TEST(PipelineTest, AWallSeenThroughTheGapBetweenTwoCarsIsNotACar) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // A 3.8 m stretch of wall 10 m ahead: alone, as long, thin and tall as a car's side.
+  const std::pair<Eigen::Vector2f, Eigen::Vector2f> wall{{10.f, -1.9f}, {10.f, 1.9f}};
+  auto wall_class = [](const FrameResult& r) {
+    for (const auto& o : r.obstacles.obstacles) {
+      if (std::abs(o.center_m.y()) < 0.5 && o.center_m.x() > 9.5) return o.class_name;
+    }
+    return std::string("none");
+  };
+  const FrameResult alone = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1, {FacesAhead({wall})}, std::nullopt, std::nullopt);
+  ASSERT_EQ(wall_class(alone), "car") << "the wall alone must read as a car's side for this test";
+
+  // Two parked cars' fronts 4.6 m nearer, the wall seen between them (the front camera sits at
+  // x = 1.4 m): where it ends is where the cars hide it, so its length is no evidence of a car.
+  const std::pair<Eigen::Vector2f, Eigen::Vector2f> left_front{{5.4f, 0.95f}, {5.4f, 2.75f}},
+      right_front{{5.4f, -0.95f}, {5.4f, -2.75f}};
+  const FrameResult framed = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1,
+      {FacesAhead({wall, left_front, right_front})},
+      std::nullopt, std::nullopt);
+  EXPECT_EQ(wall_class(framed), "unknown");
+  // A nearer car on one side only leaves the other end free: still a car's side.
+  const FrameResult one_side = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1, {FacesAhead({wall, left_front})}, std::nullopt,
+      std::nullopt);
+  EXPECT_EQ(wall_class(one_side), "car");
+}
+
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, PipelineParams{});
@@ -261,6 +310,9 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;
   params.tandem_min_length_m = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.tandem_min_length_m = 0.9;
+  params.framed_end_gap_deg = 90.0;
   EXPECT_THROW(params.Validate(), romo::Error);
 }
 

@@ -18,6 +18,8 @@
 namespace romo::pipeline {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 using Clock = std::chrono::steady_clock;
 
 double MsSince(Clock::time_point t0) {
@@ -166,6 +168,12 @@ void PipelineParams::Validate() const {
   if (!(tandem_min_length_m >= 0)) {
     Fail("pipeline: tandem_min_length_m must be >= 0, got " + std::to_string(tandem_min_length_m));
   }
+  if (!(framed_min_length_m >= 0) || !(framed_occluder_margin_m >= 0) ||
+      !(framed_end_gap_deg > 0 && framed_end_gap_deg < 45)) {
+    Fail("pipeline: framed_* out of range (length " + std::to_string(framed_min_length_m) + " m >= 0, margin " +
+         std::to_string(framed_occluder_margin_m) + " m >= 0, end gap " + std::to_string(framed_end_gap_deg) +
+         " deg in (0, 45))");
+  }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
   }
@@ -269,6 +277,7 @@ class Pipeline::Impl {
     bool on_ground = false;
     double depth_spread_m = 0.0;
     objects::ViewedBox viewed;
+    bool framed = false;  // cut off by nearer objects at both ends: its extents are no evidence
   };
   Seen See(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob, const Eigen::Vector3f& up,
            const Eigen::Vector2f& viewer) const {
@@ -317,6 +326,50 @@ class Pipeline::Impl {
           seen->erase(seen->begin() + at);
           merged = true;
         }
+      }
+    }
+  }
+
+  // Unclassifies car-classed blobs whose length nearer objects cut off at both ends
+  // (PipelineParams::framed_*).
+  void UnclassifyFramedFaces(const FrameResult& r, const std::vector<Eigen::Vector2f>& viewers,
+                             std::vector<Seen>* seen) const {
+    if (params.framed_min_length_m <= 0.0 || car_class < 0) return;
+    const double gap_rad = params.framed_end_gap_deg * kPi / 180.0;
+    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+      Seen& face = (*seen)[i];
+      if (face.viewed.classification.class_index != car_class || r.boxes[i].size.x() < params.framed_min_length_m) {
+        continue;
+      }
+      // Azimuths relative to the blob's centre direction (no wrap-around for anything in view).
+      const Eigen::Vector2d viewer = viewers[i].cast<double>();
+      const Eigen::Vector2d to_centre = r.boxes[i].center.head<2>().cast<double>() - viewer;
+      const double centre_azimuth = std::atan2(to_centre.y(), to_centre.x());
+      auto polar = [&](int point) {
+        const Eigen::Vector2d d = r.cloud.xyz.col(point).head<2>().cast<double>() - viewer;
+        return std::pair<double, double>{std::remainder(std::atan2(d.y(), d.x()) - centre_azimuth, 2.0 * kPi), d.norm()};
+      };
+      double lo = kPi, hi = -kPi, range_lo = 0.0, range_hi = 0.0, farthest = 0.0;
+      for (int p : r.blobs[i]) {
+        const auto [azimuth, range] = polar(p);
+        if (azimuth < lo) lo = azimuth, range_lo = range;
+        if (azimuth > hi) hi = azimuth, range_hi = range;
+        farthest = std::max(farthest, range);
+      }
+      int framing_lo = 0, framing_hi = 0;
+      for (std::size_t j = 0; j < r.blobs.size(); ++j) {
+        if (j == i || (r.boxes[j].center.head<2>().cast<double>() - viewer).norm() > farthest) continue;
+        for (int p : r.blobs[j]) {
+          const auto [azimuth, range] = polar(p);
+          framing_lo += azimuth >= lo - gap_rad && azimuth <= lo && range < range_lo - params.framed_occluder_margin_m;
+          framing_hi += azimuth <= hi + gap_rad && azimuth >= hi && range < range_hi - params.framed_occluder_margin_m;
+        }
+      }
+      constexpr int kMinFramingPoints = 10;  // a few stray matches do not frame anything
+      if (framing_lo >= kMinFramingPoints && framing_hi >= kMinFramingPoints) {
+        face.viewed.classification = {atlas.unknown_index(), 0.0};
+        face.viewed.box = r.boxes[i];
+        face.framed = true;
       }
     }
   }
@@ -579,6 +632,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], up, viewers[i]));
   s.MergeFragments(r, up, &viewers, &seen);
   s.SplitTandems(r, up, &viewers, &seen);
+  s.UnclassifyFramedFaces(r, viewers, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {
@@ -604,7 +658,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // extents can be one (a fragment too low for a car stays unknown).
   for (const objects::Track& tr : r.tracks) {
     const int i = tr.detection_index;
-    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground) continue;
+    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground || seen[i].framed) continue;
     if (tr.class_index < 0 || tr.class_index == s.atlas.unknown_index() ||
         tr.class_index == detections[i].classification.class_index) {
       continue;
@@ -683,7 +737,15 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     } else if (tr.state == objects::TrackState::kLost && tr.class_index >= 0 &&
                tr.class_index != s.atlas.unknown_index() && !s.parked.count(tr.id)) {
       // (a parked car hidden now is listed where it was seen, below, not where its track coasts)
-      r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
+      planning_iface::Obstacle o = track_obstacle(tr, 0);
+      // A track voted a car on earlier views and fed fragments since keeps a fragment's box: it is
+      // still something to avoid, but not a car where it coasts. A person stays a person however
+      // little of them was seen last: planning must not forget who walked behind a car.
+      const auto& cls = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)];
+      if (!cls.predict_path && s.atlas.Score(tr.class_index, tr.length_m, tr.width_m, tr.height_m) < s.atlas.min_score()) {
+        o.class_name = s.atlas.classes()[static_cast<std::size_t>(s.atlas.unknown_index())].name;
+      }
+      r.obstacles.obstacles.push_back(o);
     }
   }
   for (std::size_t i = 0; i < r.boxes.size(); ++i) {

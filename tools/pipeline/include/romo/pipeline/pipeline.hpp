@@ -61,6 +61,15 @@ struct PipelineParams {
   /// sight line stay one blob (0.6 m apart on the simulated scene: 56 of 196 pedestrian sightings
   /// lost). 0.9 m is longer than one person's stride (Atlas pedestrian mean + 1.2 sigma). 0 = off.
   double tandem_min_length_m = 0.9;
+  /// A car-classed blob at least framed_min_length_m long whose two ends, seen from its camera,
+  /// both meet objects nearer by framed_occluder_margin_m is left unclassified: its length is only
+  /// where the nearer objects cut it off (a hedge or wall seen through the gap between two parked
+  /// cars), so it says nothing about a car. 2.6 m is longer than any car front (Atlas width max),
+  /// so a car front between two cars stays a car; 0 turns the check off.
+  double framed_min_length_m = 2.6;
+  double framed_occluder_margin_m = 0.8;
+  /// How far beyond an end (degrees, seen from the camera) a nearer object still frames it.
+  double framed_end_gap_deg = 6.0;
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
   /// Parked cars are remembered in the world frame while the ground under them stays unseen: a
