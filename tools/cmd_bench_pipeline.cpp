@@ -87,13 +87,21 @@ void Bench(const BenchOptions& o) {
     pipeline::PipelineParams no_denoise = params_for(2);
     no_denoise.noise_dominated_fraction = std::numeric_limits<double>::infinity();
     const double boxes_without = measure(no_denoise, nullptr, &unused)["boxes"];
+    pipeline::PipelineParams line_of_sight_only = params_for(2);
+    line_of_sight_only.completion.face_max_thickness_m = 0.0;
+    line_of_sight_only.tandem_min_length_m = 0.0;
+    line_of_sight_only.framed_min_length_m = 0.0;
+    const double classes_without = measure(line_of_sight_only, nullptr, &unused)["classes"];
     std::printf("  vs baselines (2 threads): stereo with the outline filter %.1f ms / %.1f ms without = %.3f; "
-                "boxes with the de-noised heading %.1f ms / %.1f ms without = %.3f\n",
+                "boxes with the de-noised heading %.1f ms / %.1f ms without = %.3f; classes with lone faces, "
+                "tandem split and framed faces %.2f ms / %.2f ms without = %.3f\n",
                 with_both["stereo"], stereo_without, with_both["stereo"] / stereo_without, with_both["boxes"],
-                boxes_without, with_both["boxes"] / boxes_without);
+                boxes_without, with_both["boxes"] / boxes_without, with_both["classes"], classes_without,
+                with_both["classes"] / classes_without);
     baselines << (baselines.tellp() > 0 ? "," : "") << "{\"scale\":" << scale
               << ",\"stereo_outline_filter_ratio\":" << with_both["stereo"] / stereo_without
-              << ",\"boxes_denoised_heading_ratio\":" << with_both["boxes"] / boxes_without << "}";
+              << ",\"boxes_denoised_heading_ratio\":" << with_both["boxes"] / boxes_without
+              << ",\"classes_extra_readings_ratio\":" << with_both["classes"] / classes_without << "}";
   }
   js << "],\"baselines\":[" << baselines.str() << "]}";
   if (o.json) std::printf("%s\n", js.str().c_str());
