@@ -330,43 +330,56 @@ class Pipeline::Impl {
     }
   }
 
+  // Whether the ends of blob @p i at its smaller and larger azimuth, seen from @p viewer, meet
+  // objects nearer by PipelineParams::framed_occluder_margin_m within framed_end_gap_deg beyond.
+  std::array<bool, 2> FramedEnds(const FrameResult& r, std::size_t i, const Eigen::Vector2f& viewer_f) const {
+    const double gap_rad = params.framed_end_gap_deg * kPi / 180.0;
+    // Azimuths relative to the blob's centre direction (no wrap-around for anything in view).
+    const Eigen::Vector2d viewer = viewer_f.cast<double>();
+    const Eigen::Vector2d to_centre = r.boxes[i].center.head<2>().cast<double>() - viewer;
+    const double centre_azimuth = std::atan2(to_centre.y(), to_centre.x());
+    auto polar = [&](int point) {
+      const Eigen::Vector2d d = r.cloud.xyz.col(point).head<2>().cast<double>() - viewer;
+      return std::pair<double, double>{std::remainder(std::atan2(d.y(), d.x()) - centre_azimuth, 2.0 * kPi), d.norm()};
+    };
+    double azimuth_at[2] = {kPi, -kPi}, range_at[2] = {0.0, 0.0}, farthest = 0.0;
+    for (int p : r.blobs[i]) {
+      const auto [azimuth, range] = polar(p);
+      for (int e = 0; e < 2; ++e) {
+        if (e == 0 ? azimuth < azimuth_at[0] : azimuth > azimuth_at[1]) {
+          azimuth_at[e] = azimuth;
+          range_at[e] = range;
+        }
+      }
+      farthest = std::max(farthest, range);
+    }
+    int framing[2] = {0, 0};
+    for (std::size_t j = 0; j < r.blobs.size(); ++j) {
+      if (j == i || (r.boxes[j].center.head<2>().cast<double>() - viewer).norm() > farthest) continue;
+      for (int p : r.blobs[j]) {
+        const auto [azimuth, range] = polar(p);
+        framing[0] += azimuth >= azimuth_at[0] - gap_rad && azimuth <= azimuth_at[0] &&
+                      range < range_at[0] - params.framed_occluder_margin_m;
+        framing[1] += azimuth <= azimuth_at[1] + gap_rad && azimuth >= azimuth_at[1] &&
+                      range < range_at[1] - params.framed_occluder_margin_m;
+      }
+    }
+    constexpr int kMinFramingPoints = 10;  // a few stray matches do not frame anything
+    return {framing[0] >= kMinFramingPoints, framing[1] >= kMinFramingPoints};
+  }
+
   // Unclassifies car-classed blobs whose length nearer objects cut off at both ends
   // (PipelineParams::framed_*).
   void UnclassifyFramedFaces(const FrameResult& r, const std::vector<Eigen::Vector2f>& viewers,
                              std::vector<Seen>* seen) const {
     if (params.framed_min_length_m <= 0.0 || car_class < 0) return;
-    const double gap_rad = params.framed_end_gap_deg * kPi / 180.0;
     for (std::size_t i = 0; i < r.boxes.size(); ++i) {
       Seen& face = (*seen)[i];
       if (face.viewed.classification.class_index != car_class || r.boxes[i].size.x() < params.framed_min_length_m) {
         continue;
       }
-      // Azimuths relative to the blob's centre direction (no wrap-around for anything in view).
-      const Eigen::Vector2d viewer = viewers[i].cast<double>();
-      const Eigen::Vector2d to_centre = r.boxes[i].center.head<2>().cast<double>() - viewer;
-      const double centre_azimuth = std::atan2(to_centre.y(), to_centre.x());
-      auto polar = [&](int point) {
-        const Eigen::Vector2d d = r.cloud.xyz.col(point).head<2>().cast<double>() - viewer;
-        return std::pair<double, double>{std::remainder(std::atan2(d.y(), d.x()) - centre_azimuth, 2.0 * kPi), d.norm()};
-      };
-      double lo = kPi, hi = -kPi, range_lo = 0.0, range_hi = 0.0, farthest = 0.0;
-      for (int p : r.blobs[i]) {
-        const auto [azimuth, range] = polar(p);
-        if (azimuth < lo) lo = azimuth, range_lo = range;
-        if (azimuth > hi) hi = azimuth, range_hi = range;
-        farthest = std::max(farthest, range);
-      }
-      int framing_lo = 0, framing_hi = 0;
-      for (std::size_t j = 0; j < r.blobs.size(); ++j) {
-        if (j == i || (r.boxes[j].center.head<2>().cast<double>() - viewer).norm() > farthest) continue;
-        for (int p : r.blobs[j]) {
-          const auto [azimuth, range] = polar(p);
-          framing_lo += azimuth >= lo - gap_rad && azimuth <= lo && range < range_lo - params.framed_occluder_margin_m;
-          framing_hi += azimuth <= hi + gap_rad && azimuth >= hi && range < range_hi - params.framed_occluder_margin_m;
-        }
-      }
-      constexpr int kMinFramingPoints = 10;  // a few stray matches do not frame anything
-      if (framing_lo >= kMinFramingPoints && framing_hi >= kMinFramingPoints) {
+      const std::array<bool, 2> framed = FramedEnds(r, i, viewers[i]);
+      if (framed[0] && framed[1]) {
         face.viewed.classification = {atlas.unknown_index(), 0.0};
         face.viewed.box = r.boxes[i];
         face.framed = true;
