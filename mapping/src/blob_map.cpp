@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "romo/core/check.hpp"
@@ -154,9 +155,13 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
         any = true;
       }
     }
-    std::vector<int> matched_stored;
-    std::vector<Eigen::Vector3d> fused_points;
-    std::vector<char> was_matched(blob.size(), 0);
+    // Matches are only pending until the rigid check: a blob update is all or nothing.
+    struct Pending {
+      int q = 0, fi = 0, fq = 0;
+      Eigen::Vector3d fused;
+      Eigen::Matrix3d cov;
+    };
+    std::vector<Pending> pending;
     for (std::size_t q = 0; q < blob.size(); ++q) {
       const Projection& pr = proj[j][q];
       if (pr.u < 0) continue;  // out of view: case 4, unchanged
@@ -185,19 +190,18 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
         }
       }
       if (best_i >= 0) {
-        // Kalman fusion (eqs. 3.8-3.10) with H = I.
+        // Kalman fusion (eqs. 3.8-3.10) with H = I; committed after the rigid check.
         const Eigen::Matrix3d& P = blob.cov_world[q];
         const Eigen::Matrix3d S = P + fresh[best_i].cov_world[best_q];
         const Eigen::Matrix3d K = P * S.inverse();
-        const Eigen::Vector3d f = blob.xyz_world.col(q) + K * (fresh[best_i].xyz_world.col(best_q) - blob.xyz_world.col(q));
-        matched_stored.push_back(static_cast<int>(q));
-        fused_points.push_back(f);
-        blob.cov_world[q] = P - K * P;
-        fresh_used[best_i][best_q] = 1;
-        fresh_merged[best_i] = 1;
-        was_matched[q] = 1;
-        UpdateEvidence(Visibility::kMatched, &blob.evidence[q]);
-        ++out.matched;
+        Pending m;
+        m.q = static_cast<int>(q);
+        m.fi = best_i;
+        m.fq = best_q;
+        m.fused = blob.xyz_world.col(q) + K * (fresh[best_i].xyz_world.col(best_q) - blob.xyz_world.col(q));
+        m.cov = P - K * P;
+        pending.push_back(m);
+        fresh_used[best_i][best_q] = 1;  // one stored point per observation, also while pending
         continue;
       }
       // Not matched: unobserved prediction if it should have been seen (front-most and nothing
@@ -213,22 +217,40 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
       }
     }
     // Rigid check (eq. 3.11): the transform from the stored matched points to the fused ones,
-    // applied to every point of the blob, so occluded parts follow the update.
-    if (matched_stored.size() >= 3) {
+    // applied to every point of the blob, so occluded parts follow the update. Only its inliers
+    // are fused (position, covariance, support); when it fails (fewer than rigid.min_inliers
+    // consistent matches) the blob keeps its points, covariances and evidence as they were and
+    // the observations stay free for the other candidates or a new blob.
+    std::optional<RigidMotion> rigid;
+    if (!pending.empty()) {
       MatchedPoints3D m;
-      m.p1.resize(3, matched_stored.size());
-      m.p2.resize(3, matched_stored.size());
-      for (std::size_t i = 0; i < matched_stored.size(); ++i) {
-        m.p1.col(i) = blob.xyz_world.col(matched_stored[i]);
-        m.p2.col(i) = fused_points[i];
-        m.cov1.push_back(blob.cov_world[matched_stored[i]]);
-        m.cov2.push_back(blob.cov_world[matched_stored[i]]);
+      m.p1.resize(3, static_cast<Eigen::Index>(pending.size()));
+      m.p2.resize(3, static_cast<Eigen::Index>(pending.size()));
+      for (std::size_t i = 0; i < pending.size(); ++i) {
+        m.p1.col(i) = blob.xyz_world.col(pending[i].q);
+        m.p2.col(i) = pending[i].fused;
+        m.cov1.push_back(blob.cov_world[pending[i].q]);
+        m.cov2.push_back(pending[i].cov);
       }
-      if (const auto rigid = EstimateRigidMotion(m, params_.rigid)) {
-        for (std::size_t q = 0; q < blob.size(); ++q) blob.xyz_world.col(q) = rigid->T_2_1 * blob.xyz_world.col(q).eval();
-        for (int i : rigid->inliers) blob.xyz_world.col(matched_stored[i]) = fused_points[i];
-        out.corrections.emplace_back(blob.id, rigid->T_2_1);
+      rigid = EstimateRigidMotion(m, params_.rigid);
+    }
+    std::vector<char> is_inlier(pending.size(), 0);
+    if (rigid) {
+      for (int i : rigid->inliers) is_inlier[i] = 1;
+      for (std::size_t q = 0; q < blob.size(); ++q) blob.xyz_world.col(q) = rigid->T_2_1 * blob.xyz_world.col(q).eval();
+      out.corrections.emplace_back(blob.id, rigid->T_2_1);
+    }
+    for (std::size_t i = 0; i < pending.size(); ++i) {
+      const Pending& m = pending[i];
+      if (!is_inlier[i]) {
+        fresh_used[m.fi][m.fq] = 0;
+        continue;
       }
+      blob.xyz_world.col(m.q) = m.fused;
+      blob.cov_world[m.q] = m.cov;
+      UpdateEvidence(Visibility::kMatched, &blob.evidence[m.q]);
+      fresh_merged[m.fi] = 1;
+      ++out.matched;
     }
     // Unmatched points of the fresh blobs fused here are unpredicted observations: added.
     for (std::size_t i = 0; i < fresh.size(); ++i) {

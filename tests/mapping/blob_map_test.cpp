@@ -1,6 +1,8 @@
 // Blob map on simulated scenes: object completion with confidence values (the trend of Tables
 // 5.2/5.3) and a blob update propagated under partial occlusion.
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -169,6 +171,56 @@ TEST(BlobMapTest, PartialOcclusionPropagatesTheUpdateToHiddenPoints) {
   constexpr double kTolAcrossM = 0.005;
   EXPECT_NEAR(moved.y(), 0.0, kTolAcrossM);
   EXPECT_NEAR(moved.z(), 0.0, kTolAcrossM);
+}
+
+// A blob of @p n points at z = 1 m on a pixel grid of a 64x48 camera at the origin.
+ObservedBlob GridBlob(int n, double dz_m) {
+  ObservedBlob b;
+  b.xyz_world.resize(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double u = 8 + 4 * (i % 8), v = 8 + 4 * (i / 8);
+    b.xyz_world.col(i) = Eigen::Vector3d((u - 31.5) / 100.0, (v - 23.5) / 100.0, 1.0 + dz_m);
+    b.cov_world.push_back(kSigmaM * kSigmaM * Eigen::Matrix3d::Identity());
+  }
+  return b;
+}
+
+TEST(BlobMapTest, AFailedRigidCheckLeavesTheBlobUntouched) {
+  const PinholeCamera cam{100, 100, 31.5, 23.5, 64, 48};
+  const BlobMapParams params;
+  ASSERT_EQ(params.rigid.min_inliers, 8);
+  for (const int n : {5, 12}) {
+    SCOPED_TRACE("matches " + std::to_string(n));
+    BlobMap map{params};
+    map.Update({GridBlob(n, 0.0)}, cam, {});
+    const Blob before = map.blobs().front();
+    const auto upd = map.Update({GridBlob(n, 0.002)}, cam, {});
+    const Blob& after = map.blobs().front();
+    double cov_change = 0, moved = 0;
+    for (std::size_t i = 0; i < before.size(); ++i) {
+      cov_change = std::max(cov_change, (after.cov_world[i] - before.cov_world[i]).norm());
+      moved = std::max(moved, (after.xyz_world.col(i) - before.xyz_world.col(i)).norm());
+    }
+    if (n < params.rigid.min_inliers) {
+      // All or nothing: no position, covariance or support changes, and the observation is
+      // not merged (it starts a blob of its own).
+      EXPECT_EQ(upd.matched, 0);
+      EXPECT_TRUE(upd.corrections.empty());
+      EXPECT_EQ(cov_change, 0.0);
+      EXPECT_EQ(moved, 0.0);
+      for (const auto& e : after.evidence) EXPECT_EQ(e.supported, 1);
+      EXPECT_EQ(upd.new_blobs, 1);
+      EXPECT_EQ(map.blobs().size(), 2u);
+    } else {
+      // Enough matches: fused half way (equal covariances), covariances halved, support 2.
+      EXPECT_EQ(upd.matched, n);
+      EXPECT_EQ(upd.corrections.size(), 1u);
+      EXPECT_NEAR(moved, 0.001, 1e-6);
+      EXPECT_NEAR(after.cov_world[0](0, 0), 0.5 * before.cov_world[0](0, 0), 1e-12);
+      for (const auto& e : after.evidence) EXPECT_EQ(e.supported, 2);
+      EXPECT_EQ(map.blobs().size(), 1u);
+    }
+  }
 }
 
 TEST(BlobMapTest, IntersectionSearchPairsCollidingBoxesOnly) {
