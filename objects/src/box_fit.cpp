@@ -133,8 +133,27 @@ float CanonicalYaw(float yaw_rad, float* length_m, float* width_m, std::optional
   return WrapPi(best_yaw);
 }
 
-Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
+namespace {
+
+/// Rotates @p axes about col(2) by k * 90 deg (k = 0..3), permuting @p size's first two extents
+/// with them: the same box under another name.
+void TurnAboutThirdAxis(int k, Eigen::Matrix3f* axes, Eigen::Vector3f* size) {
+  for (int q = 0; q < k; ++q) {
+    const Eigen::Vector3f c0 = axes->col(0);
+    axes->col(0) = axes->col(1);
+    axes->col(1) = -c0;
+    std::swap(size->x(), size->y());
+  }
+}
+
+/// Heading of @p axes' col(0) projected onto the xy plane, radians.
+float HeadingOf(const Eigen::Matrix3f& axes) { return std::atan2(axes(1, 0), axes(0, 0)); }
+
+}  // namespace
+
+Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, std::optional<float> hint_yaw_rad) {
   CheckIndices(xyz, indices, "FitPcaBox");
+  if (hint_yaw_rad && !std::isfinite(*hint_yaw_rad)) Fail("FitPcaBox: hint_yaw_rad is not finite");
   const PointScatter stats = ComputeScatter(xyz, indices);
   const Eigen::Vector3d& mean = stats.mean;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(stats.scatter);
@@ -156,21 +175,38 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices) {
   Box3 box;
   box.size = hi - lo;
   box.center = m + axes * (0.5f * (hi + lo));
-  if (box.size.x() < box.size.y()) {  // length first: rotate 90 deg about col(2)
-    const Eigen::Vector3f c0 = axes.col(0);
-    axes.col(0) = axes.col(1);
-    axes.col(1) = -c0;
-    std::swap(box.size.x(), box.size.y());
+  if (!hint_yaw_rad) {
+    if (box.size.x() < box.size.y()) TurnAboutThirdAxis(1, &axes, &box.size);  // length first
+    if (const float yaw = HeadingOf(axes); yaw < -0.5f * kPi || yaw >= 0.5f * kPi) {
+      // Heading outside [-pi/2, pi/2): turn the box 180 deg about col(2) (same box, other name).
+      TurnAboutThirdAxis(2, &axes, &box.size);
+    }
+    box.axes = axes;
+    box.yaw_rad = HeadingOf(axes);
+    return box;
   }
-  float yaw = std::atan2(axes(1, 0), axes(0, 0));
-  if (yaw < -0.5f * kPi || yaw >= 0.5f * kPi) {
-    // Heading outside [-pi/2, pi/2): turn the box 180 deg about col(2) (same box, other name).
-    axes.col(0) = -axes.col(0);
-    axes.col(1) = -axes.col(1);
-    yaw = std::atan2(axes(1, 0), axes(0, 0));
+  // With a hint: of the four names of the box (turns about col(2) by k * 90 deg), the one whose
+  // heading is nearest the hint, keeping length >= width unless the footprint is nearly square
+  // (as CanonicalYaw does for vertical boxes).
+  const float l = box.size.x(), w = box.size.y();
+  const bool near_square = std::abs(l - w) < kNearSquareFraction * std::max(l, w);
+  int best_k = -1;
+  float best_err = 1e9f;
+  for (int k = 0; k < 4; ++k) {
+    Eigen::Matrix3f cand_axes = axes;
+    Eigen::Vector3f cand_size = box.size;
+    TurnAboutThirdAxis(k, &cand_axes, &cand_size);
+    if (!near_square && cand_size.x() < cand_size.y()) continue;
+    const float err = std::abs(WrapPi(HeadingOf(cand_axes) - *hint_yaw_rad));
+    if (err < best_err) {
+      best_err = err;
+      best_k = k;
+    }
   }
+  ROMO_DEMAND(best_k >= 0);
+  TurnAboutThirdAxis(best_k, &axes, &box.size);
   box.axes = axes;
-  box.yaw_rad = yaw;
+  box.yaw_rad = WrapPi(HeadingOf(axes));
   return box;
 }
 

@@ -1,5 +1,8 @@
 #include <cmath>
+#include <cstdint>
+#include <optional>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -135,6 +138,75 @@ TEST(BoxFitTest, HeadingIsStableAcrossFramesWithoutFlips) {
   }
 }
 
+TEST(BoxFitTest, HintedHeadingIsContinuousAcrossTheSeamOverFortyFrames) {
+  // A car and a near-square crate turning 0.01 rad per frame across the +-pi/2 seam (frame 20),
+  // re-sampled each frame (new noise), each frame's yaw fed back as the next frame's hint.
+  constexpr int kFrames = 40;
+  constexpr float kTurnPerFrameRad = 0.01f;
+  // Bounds on one frame-to-frame yaw change: the true turn plus twice the worst single-frame fit
+  // error (measured on these clouds: PCA car 0.009 rad; vertical car 0.004, crate 0.021).
+  constexpr float kMaxPcaCarJumpRad = 0.05f;
+  constexpr float kMaxVerticalJumpRad = 0.08f;
+  // A near-square footprint's second moments hardly tell a heading: PCA's axes of the crate are
+  // off by up to 0.6 rad (mod 90 deg) from noise alone, and the hint can only pick the nearest of
+  // the box's four names, so the bound is that: no 90 or 180 deg flip, under pi/4 plus the turn.
+  constexpr float kMaxPcaSquareJumpRad = kPi / 4 + kTurnPerFrameRad;
+  constexpr float kMaxCarYawErrorRad = 0.03f;     // against the truth, mod 180 deg
+  constexpr float kMaxVerticalYawErrorRad = 0.05f;  // crate: against the truth, mod 90 deg
+  struct Object {
+    const char* name;
+    Eigen::Vector3f size;
+    float max_pca_jump_rad;
+  };
+  for (const Object& obj : {Object{"car", {4.5f, 1.8f, 1.5f}, kMaxPcaCarJumpRad},
+                            Object{"crate", {1.0f, 0.97f, 0.6f}, kMaxPcaSquareJumpRad}}) {
+    const bool car = obj.size.x() > 2.f;
+    float pca_prev = 0.f, vert_prev = 0.f, unhinted_prev = 0.f, unhinted_max_jump = 0.f;
+    for (int frame = 0; frame < kFrames; ++frame) {
+      mapping::SceneObject o;
+      o.center_xy = {8.f, 3.f};
+      o.size = obj.size;
+      o.yaw_rad = kPi / 2 - 0.2f + kTurnPerFrameRad * static_cast<float>(frame);
+      mapping::SyntheticSceneParams sp;
+      sp.density_per_m2 = 800.f;
+      sp.noise_m = 0.01f;
+      sp.seed = 500 + static_cast<std::uint64_t>(frame);
+      const auto scene = mapping::MakeSyntheticScene({o}, sp);
+      const std::vector<int> idx = PointsOf(scene, 0);
+      const std::optional<float> pca_hint = frame == 0 ? o.yaw_rad : pca_prev;
+      const std::optional<float> vert_hint = frame == 0 ? o.yaw_rad : vert_prev;
+      const Box3 pca = FitPcaBox(scene.cloud.xyz, idx, pca_hint);
+      const Box3 vert = FitVerticalBox(scene.cloud.xyz, idx, Eigen::Vector3f::UnitZ(), vert_hint);
+      const Box3 unhinted = FitPcaBox(scene.cloud.xyz, idx);
+      const std::string at = std::string(obj.name) + " frame " + std::to_string(frame);
+      EXPECT_NEAR(pca.axes.determinant(), 1.f, 1e-5f) << at;
+      EXPECT_GT(pca.axes(2, 2), 0.f) << at;
+      EXPECT_NEAR(pca.yaw_rad, std::atan2(pca.axes(1, 0), pca.axes(0, 0)), 1e-5f) << at;
+      if (car) {
+        EXPECT_GE(pca.size.x(), pca.size.y()) << at;
+        EXPECT_GE(vert.size.x(), vert.size.y()) << at;
+        EXPECT_LT(AngleDiffHalfTurn(pca.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
+        EXPECT_LT(AngleDiffHalfTurn(vert.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
+      } else {
+        EXPECT_LT(std::abs(std::remainder(vert.yaw_rad - o.yaw_rad, kPi / 2)), kMaxVerticalYawErrorRad) << at;
+      }
+      if (frame > 0) {
+        EXPECT_LT(std::abs(std::remainder(pca.yaw_rad - pca_prev, 2.f * kPi)), obj.max_pca_jump_rad) << at;
+        EXPECT_LT(std::abs(std::remainder(vert.yaw_rad - vert_prev, 2.f * kPi)), kMaxVerticalJumpRad) << at;
+        unhinted_max_jump =
+            std::max(unhinted_max_jump, std::abs(std::remainder(unhinted.yaw_rad - unhinted_prev, 2.f * kPi)));
+      }
+      pca_prev = pca.yaw_rad;
+      vert_prev = vert.yaw_rad;
+      unhinted_prev = unhinted.yaw_rad;
+    }
+    // Without the hint the half-open range wraps at the seam: the scene does cross it.
+    if (car) {
+      EXPECT_GT(unhinted_max_jump, 3.f) << obj.name;
+    }
+  }
+}
+
 TEST(BoxFitTest, CanonicalYawRules) {
   float l = 1.f, w = 3.f;
   EXPECT_NEAR(CanonicalYaw(0.2f, &l, &w), 0.2f + kPi / 2 - kPi, 1e-6f);
@@ -249,6 +321,7 @@ TEST(BoxFitTest, BadInputIsRejected) {
   xyz.col(0) = Eigen::Vector3f(1, 2, 3);
   xyz.col(1) = Eigen::Vector3f(std::nanf(""), 0, 0);
   EXPECT_THROW(FitPcaBox(xyz, {}), romo::Error);
+  EXPECT_THROW(FitPcaBox(xyz, {0}, std::nanf("")), romo::Error);
   EXPECT_THROW(FitVerticalBox(xyz, {}), romo::Error);
   EXPECT_THROW(FitVerticalBox(xyz, {1}), romo::Error);
   EXPECT_THROW(FitVerticalBox(xyz, {2}), romo::Error);

@@ -35,8 +35,14 @@ struct Box3 {
 /// Full 3D PCA box of the points @p indices of @p xyz (3 x N, metres): axes are the principal
 /// directions (largest variance first), extents the min/max projections. col(2) is flipped to
 /// point up (+z) and col(0) canonicalised as in the header note.
-/// @throws romo::Error when @p indices is empty, out of range or names a non-finite point.
-Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices);
+/// @param hint_yaw_rad previous heading of the same object, optional: the box is turned about
+///        col(2) by a multiple of 90 deg so that its yaw is the one nearest the hint, keeping
+///        length >= width unless the footprint (length, width) is nearly square (as CanonicalYaw).
+///        The yaw (of col(0) projected onto xy) only means a heading where col(2) is near vertical.
+/// @throws romo::Error when @p indices is empty, out of range or names a non-finite point, or
+///         for a non-finite @p hint_yaw_rad.
+Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
+               std::optional<float> hint_yaw_rad = std::nullopt);
 
 /// Vertical cuboid: height along @p up (unit ground normal, e.g. from ground removal), footprint
 /// the minimum-area rectangle of the points projected onto the ground plane (rotating calipers
