@@ -200,6 +200,12 @@ void Record(const RecordOptions& options) {
   std::unique_ptr<drivers::FrameSource> source = drivers::OpenSource(options.source);
   drivers::LogWriter writer(options.out,
                             options.png ? drivers::ImageEncoding::kPng : drivers::ImageEncoding::kRaw);
+  if (!writer.kept_interrupted().empty()) {
+    const std::string event = "record: " + options.out + ".partial was left by an interrupted recording; kept as " +
+                              writer.kept_interrupted();
+    std::fprintf(stderr, "romo %s\n", event.c_str());
+    status.AddEvent(event);
+  }
 
   StatusHeartbeat heartbeat(&status, *source);
   Progress progress("record", options.frames);

@@ -30,6 +30,9 @@ void Run(Options o) {
   const auto start = std::chrono::steady_clock::now();
   sim::SimSource source(o.sim);
   drivers::LogWriter writer(o.out, o.png ? drivers::ImageEncoding::kPng : drivers::ImageEncoding::kRaw);
+  if (!writer.kept_interrupted().empty()) {
+    std::fprintf(stderr, "romo sim: an interrupted recording was kept as %s\n", writer.kept_interrupted().c_str());
+  }
   const std::int64_t first_stamp = source.TruthAt(static_cast<std::uint64_t>(o.sim.first_frame)).stamp_ns;
   writer.WriteCalibration(*source.calibration(), first_stamp);
   Progress progress("sim " + o.sim.scene, static_cast<std::uint64_t>(o.sim.frames));

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "lcm_codec.hpp"
@@ -110,10 +111,13 @@ std::optional<std::uint64_t> FrameSequenceOf(const LogEvent& event) {
   return value;
 }
 
+// Seek offsets beyond this are no recording's (30 years) and would overflow microseconds.
+constexpr double kMaxSeekS = 1e9;
+
 class LogReader::Impl {
  public:
   Impl(const std::string& path, const Options& options) : reader_(path), options_(options) {
-    if (!(options.seek_s >= 0)) Fail(path + ": seek_s = " + std::to_string(options.seek_s) + " must be >= 0");
+    CheckSeekOffset(options.seek_s);
     LogEvent event;
     for (int i = 0; i < kCalibrationScanEvents; ++i) {
       const ReadResult result = reader_.Next(&event);
@@ -129,7 +133,14 @@ class LogReader::Impl {
       if (IsFramePartChannel(event.channel)) break;
     }
     Rewind();
-    if (options.seek_s > 0) Seek(options.seek_s);
+    // An open that delivers nothing would look like an empty recording.
+    std::optional<double> last_frame_s;
+    if (options.seek_s > 0 && !Seek(options.seek_s, &last_frame_s)) {
+      std::ostringstream what;
+      what << path << ": seek_s = " << options.seek_s << " s is past the recording's last frame";
+      if (last_frame_s) what << " (at " << *last_frame_s << " s)";
+      Fail(what.str());
+    }
   }
 
   void Rewind() {
@@ -262,18 +273,30 @@ class LogReader::Impl {
     if (due > now) std::this_thread::sleep_until(due);
   }
 
-  void Seek(double offset_s) {
-    if (!(offset_s >= 0)) Fail(reader_.path() + ": seek offset " + std::to_string(offset_s) + " s must be >= 0");
+  void CheckSeekOffset(double offset_s) const {
+    if (!(offset_s >= 0 && offset_s <= kMaxSeekS)) {
+      Fail(reader_.path() + ": seek offset " + std::to_string(offset_s) + " s must be within 0..1e9 s");
+    }
+  }
+
+  // Positions at the first frame part at or after @p offset_s; false (and at the end) when the
+  // recording has none, with the last frame's offset in @p last_frame_s.
+  bool Seek(double offset_s, std::optional<double>* last_frame_s = nullptr) {
+    CheckSeekOffset(offset_s);
     Rewind();
     const std::int64_t target_us = first_timestamp_us_ + static_cast<std::int64_t>(offset_s * 1e6);
     while (std::optional<LogEvent> event = NextEvent()) {
       if (event->channel == kCalibrationChannel) {
         UpdateCalibration(*event);
-      } else if (IsFramePartChannel(event->channel) && event->timestamp_us >= target_us) {
-        pending_ = std::move(event);
-        return;
+      } else if (IsFramePartChannel(event->channel)) {
+        if (event->timestamp_us >= target_us) {
+          pending_ = std::move(event);
+          return true;
+        }
+        if (last_frame_s) *last_frame_s = 1e-6 * static_cast<double>(event->timestamp_us - first_timestamp_us_);
       }
     }
+    return false;
   }
 
   SourceStatus Status() const {
@@ -349,7 +372,7 @@ std::unique_ptr<FrameSource> OpenLogSource(const Uri& uri) {
       Fail(uri.ToString() + ": pacing = '" + *pacing + "' must be realtime or fast");
     }
   }
-  if (const auto seek = uri.GetDouble("seek_s")) options.seek_s = *seek;
+  if (const auto seek = uri.GetDouble("seek_s", 0.0, kMaxSeekS)) options.seek_s = *seek;
   if (uri.path.empty()) Fail(uri.ToString() + ": no file named (log://FILE.lcmlog)");
   return std::make_unique<LogReader>(uri.path, options);
 }

@@ -1,6 +1,7 @@
 // LogWriter: LCM log files through lcm::LogFile, flushed per event, renamed into place on Close.
 // A failed write (disk full) cuts the file back to the last whole frame set and makes later
 // writes throw; Close() still renames it, so the recording keeps every complete frame set.
+// A .partial left by a writer that was killed is moved aside, never overwritten.
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +13,7 @@
 
 #include "lcm_codec.hpp"
 #include "romo/core/check.hpp"
+#include "romo/core/partial_file.hpp"
 #include "romo/drivers/recording.hpp"
 
 namespace romo::drivers {
@@ -21,6 +23,7 @@ class LogWriter::Impl {
   Impl(const std::string& path, ImageEncoding encoding)
       : path_(path), partial_path_(path + ".partial"), encoding_(encoding) {
     if (path.empty()) Fail("recording path is empty");
+    kept_interrupted_ = KeepInterruptedPartial(path_);
     log_ = std::make_unique<lcm::LogFile>(partial_path_, "w");
     if (!log_->good()) {
       Fail(partial_path_ + ": cannot create recording: " + std::strerror(errno));
@@ -120,6 +123,7 @@ class LogWriter::Impl {
 
   const std::string path_;
   const std::string partial_path_;
+  std::string kept_interrupted_;
   const ImageEncoding encoding_;
   std::mutex mutex_;
   std::unique_ptr<lcm::LogFile> log_;
@@ -175,5 +179,7 @@ void LogWriter::Close() { impl_->Close(); }
 std::uint64_t LogWriter::events_written() const { return impl_->events_; }
 std::uint64_t LogWriter::bytes_written() const { return impl_->bytes_; }
 const std::string& LogWriter::path() const { return impl_->path_; }
+
+const std::string& LogWriter::kept_interrupted() const { return impl_->kept_interrupted_; }
 
 }  // namespace romo::drivers

@@ -2,7 +2,9 @@
 
 #include <cerrno>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 #include "romo/core/check.hpp"
 
@@ -63,7 +65,7 @@ std::optional<std::string> Uri::Get(const std::string& key) const {
   return it->second;
 }
 
-std::optional<long long> Uri::GetInt(const std::string& key) const {
+std::optional<long long> Uri::GetInt(const std::string& key, long long min, long long max) const {
   const auto v = Get(key);
   if (!v) return std::nullopt;
   errno = 0;
@@ -72,10 +74,20 @@ std::optional<long long> Uri::GetInt(const std::string& key) const {
   if (v->empty() || *end != '\0' || errno == ERANGE) {
     Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not an integer");
   }
+  if (value < min || value > max) {
+    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is outside " + std::to_string(min) +
+         ".." + std::to_string(max));
+  }
   return value;
 }
 
-std::optional<double> Uri::GetDouble(const std::string& key) const {
+std::optional<int> Uri::GetInt32(const std::string& key) const {
+  const auto v = GetInt(key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+  if (!v) return std::nullopt;
+  return static_cast<int>(*v);
+}
+
+std::optional<double> Uri::GetDouble(const std::string& key, double min, double max) const {
   const auto v = Get(key);
   if (!v) return std::nullopt;
   errno = 0;
@@ -83,6 +95,14 @@ std::optional<double> Uri::GetDouble(const std::string& key) const {
   const double value = std::strtod(v->c_str(), &end);
   if (v->empty() || *end != '\0' || errno == ERANGE) {
     Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not a number");
+  }
+  if (!std::isfinite(value)) {
+    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not a finite number");
+  }
+  if (value < min || value > max) {
+    std::ostringstream range;
+    range << min << ".." << max;
+    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is outside " + range.str());
   }
   return value;
 }

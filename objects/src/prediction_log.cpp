@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "romo/core/check.hpp"
+#include "romo/core/partial_file.hpp"
 
 namespace romo::objects {
 namespace {
@@ -71,6 +72,7 @@ class PredictionCsvWriter::Impl {
  public:
   std::string path;
   std::string partial;
+  std::string kept_interrupted;
   std::FILE* file = nullptr;
   std::int64_t rows = 0;
 
@@ -82,6 +84,7 @@ class PredictionCsvWriter::Impl {
 PredictionCsvWriter::PredictionCsvWriter(const std::string& path) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->partial = path + ".partial";
+  impl_->kept_interrupted = KeepInterruptedPartial(path);
   impl_->file = std::fopen(impl_->partial.c_str(), "w");
   if (impl_->file == nullptr) {
     Fail("prediction log '" + impl_->partial + "': cannot create: " + std::strerror(errno));
@@ -133,5 +136,6 @@ void PredictionCsvWriter::Close() {
 
 std::int64_t PredictionCsvWriter::rows_written() const { return impl_->rows; }
 const std::string& PredictionCsvWriter::path() const { return impl_->path; }
+const std::string& PredictionCsvWriter::kept_interrupted() const { return impl_->kept_interrupted; }
 
 }  // namespace romo::objects

@@ -332,6 +332,14 @@ TEST(LogReaderTest, BadLogUriOptionsAreRejected) {
   EXPECT_NE(ErrorOf([&] { OpenSource(base + "?loop=maybe"); }).find("loop = 'maybe'"),
             std::string::npos);
   EXPECT_THROW(OpenSource(base + "?seek_s=-1"), romo::Error);
+  // Offsets no microsecond count holds were cast unchecked (undefined; in practice the whole
+  // recording from its start); an offset past the last frame delivered nothing, like an empty log.
+  EXPECT_NE(ErrorOf([&] { OpenSource(base + "?seek_s=inf"); }).find("not a finite number"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { OpenSource(base + "?seek_s=1e300"); }).find("'seek_s=1e300' is outside"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { OpenSource(base + "?seek_s=5"); }).find("seek_s = 5 s is past the recording's last frame"),
+            std::string::npos);
+  EXPECT_TRUE(OpenSource(base + "?seek_s=0")->Next());
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include <cstdio>
 #include <string>
 #include <sys/stat.h>
 #include <vector>
@@ -57,6 +58,33 @@ TEST(LogWriterTest, WritesPartialFileAndRenamesItOnClose) {
   writer.Close();  // idempotent
   EXPECT_TRUE(Exists(path));
   EXPECT_THROW(writer.Write(RampFrameSet(1)), romo::Error);
+}
+
+TEST(LogWriterTest, APartialLeftByAKilledWriterIsKeptNotOverwritten) {
+  test::ScratchDir dir;
+  const std::string path = dir / "run.lcmlog";
+  std::string killed_bytes;
+  for (int run = 1; run <= 2; ++run) {
+    {
+      // What SIGKILL leaves: the .partial with every flushed set, never renamed.
+      LogWriter killed(path);
+      killed.Write(RampFrameSet(static_cast<std::uint64_t>(run)));
+      killed_bytes = test::ReadFile(path + ".partial");
+      ASSERT_EQ(std::rename((path + ".partial").c_str(), (dir / "aside").c_str()), 0);
+    }
+    ASSERT_EQ(std::rename((dir / "aside").c_str(), (path + ".partial").c_str()), 0);
+    LogWriter next(path);
+    const std::string kept = dir / ("run.interrupted-" + std::to_string(run) + ".lcmlog");
+    EXPECT_EQ(next.kept_interrupted(), kept);
+    EXPECT_EQ(test::ReadFile(kept), killed_bytes);
+    std::int64_t cut_at = 0;
+    EXPECT_EQ(ReadAllEvents(kept, &cut_at).size(), 1u) << "one set of one rig";
+    EXPECT_EQ(cut_at, -1);
+    next.Close();
+  }
+  EXPECT_TRUE(Exists(path));
+  LogWriter clean(dir / "clean.lcmlog");
+  EXPECT_EQ(clean.kept_interrupted(), "");
 }
 
 TEST(LogWriterTest, DestructorClosesTheFile) {

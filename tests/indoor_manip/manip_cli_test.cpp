@@ -42,6 +42,10 @@ TEST(ManipCliTest, BadInputExitsWithCode2AndNamesTheProblem) {
                     dir.path());
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--plane"), std::string::npos) << r.err;
+  // 2^32 + 2 frames: narrowed to int unchecked it became 2 and passed the range check.
+  r = test::RunRomo("manip --source 'sim-manip://poking?frames=4294967298' --hand-seed 160,120 --out " + dir.path());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("'frames=4294967298' is outside"), std::string::npos) << r.err;
 }
 
 }  // namespace

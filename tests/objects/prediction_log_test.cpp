@@ -99,6 +99,12 @@ TEST(PredictionLogTest, CsvHasHeaderAndOneRowPerPosition) {
   EXPECT_EQ(first.rfind("2000000000,", 0), 0u) << first;
   EXPECT_NE(first.find(",confirmed,0,"), std::string::npos) << first;
   EXPECT_THROW(PredictionCsvWriter("/nonexistent/dir/p.csv"), romo::Error);
+
+  // A .partial left by a killed writer is moved aside, not truncated by the next run.
+  { std::ofstream(path + ".partial") << "killed mid-run\n"; }
+  PredictionCsvWriter next(path);
+  EXPECT_EQ(next.kept_interrupted(), dir / "predictions.interrupted-1.csv");
+  EXPECT_EQ(test::ReadFile(dir / "predictions.interrupted-1.csv"), "killed mid-run\n");
 }
 
 TEST(PredictionLogTest, LcmRoundTripKeepsEveryField) {

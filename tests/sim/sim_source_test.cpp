@@ -34,6 +34,9 @@ TEST(SimSourceTest, BadParametersGetClearErrors) {
       {"sim://parking?frames", "not key=value"},
       {"sim:/parking", "malformed source URI"},
       {"sim://parking?aa=9", "samples_per_axis = 9"},
+      {"sim://parking?aa=4294967298", "'aa=4294967298' is outside"},  // was narrowed to 2
+      {"sim://parking?threads=0", "'threads=0' is outside 1..256"},
+      {"sim://parking?rate_hz=inf", "'rate_hz=inf' is not a finite number"},
       {"sim://parking?depth=yes", "'depth=yes' is not 0 or 1"},
       {"sim://parking?calib=/nonexistent/cal.yaml", "/nonexistent/cal.yaml"},
   };

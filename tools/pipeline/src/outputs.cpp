@@ -89,6 +89,9 @@ OutputSink::OutputSink(const drivers::Calibration& calibration, const OutputOpti
     impl_->log = std::make_unique<drivers::LogWriter>(options.out_dir + "/outputs.lcmlog");
     impl_->calibration_to_log = calibration;
     impl_->csv = std::make_unique<objects::PredictionCsvWriter>(options.out_dir + "/predictions.csv");
+    for (const std::string& kept : {impl_->log->kept_interrupted(), impl_->csv->kept_interrupted()}) {
+      if (!kept.empty()) std::fprintf(stderr, "romo: an interrupted run's output was kept as %s\n", kept.c_str());
+    }
   }
   if (!options.lcm_url.empty()) impl_->bus = std::make_unique<pi::LcmBus>(options.lcm_url);
 }

@@ -64,16 +64,11 @@ SimParams SimParams::FromUri(const drivers::Uri& uri) {
   p.distortion = ParseFlag(uri, "distortion", p.distortion);
   if (const auto v = uri.Get("calib")) p.calibration_path = *v;
   if (const auto v = uri.GetInt("start_ns")) p.start_stamp_ns = *v;
-  if (const auto v = uri.GetInt("aa")) p.render.samples_per_axis = static_cast<int>(*v);
+  if (const auto v = uri.GetInt32("aa")) p.render.samples_per_axis = *v;
   if (const auto v = uri.GetDouble("noise")) p.render.noise_sigma = *v;
   // Output does not depend on the thread count, so use every core unless told otherwise.
   p.render.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  if (const auto v = uri.GetInt("threads")) {
-    if (*v < 1 || *v > 256) {
-      Fail("source URI " + uri.ToString() + ": 'threads=" + std::to_string(*v) + "' is outside 1-256");
-    }
-    p.render.threads = static_cast<int>(*v);
-  }
+  if (const auto v = uri.GetInt("threads", 1, 256)) p.render.threads = static_cast<int>(*v);
   p.Validate();
   return p;
 }

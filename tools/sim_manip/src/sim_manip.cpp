@@ -46,6 +46,7 @@ double KinectSigmaM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 
 struct Box {
   Eigen::Vector3d lo, hi;  // plane frame
   Eigen::Vector3d rgb;
+  std::string name;
 };
 
 }  // namespace
@@ -55,21 +56,22 @@ SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
   o.action = uri.path;
   for (const auto& [key, value] : uri.query) {
     if (key != "seed" && key != "frames" && key != "width" && key != "height" && key != "fps" &&
-        key != "noise" && key != "transports") {
+        key != "noise" && key != "transports" && key != "prop") {
       Fail("sim-manip URI '" + uri.ToString() + "': unknown query key '" + key +
-           "' (known: seed, frames, width, height, fps, noise, transports)");
+           "' (known: seed, frames, width, height, fps, noise, transports, prop)");
     }
   }
   if (auto v = uri.GetInt("seed")) {
     if (*v < 0) Fail("sim-manip URI: seed must be >= 0, got " + std::to_string(*v));
     o.seed = static_cast<std::uint64_t>(*v);
   }
-  if (auto v = uri.GetInt("frames")) o.frames = static_cast<int>(*v);
-  if (auto v = uri.GetInt("width")) o.width_px = static_cast<int>(*v);
-  if (auto v = uri.GetInt("height")) o.height_px = static_cast<int>(*v);
+  if (auto v = uri.GetInt32("frames")) o.frames = *v;
+  if (auto v = uri.GetInt32("width")) o.width_px = *v;
+  if (auto v = uri.GetInt32("height")) o.height_px = *v;
   if (auto v = uri.GetDouble("fps")) o.fps = *v;
   if (auto v = uri.GetInt("noise")) o.noise = *v != 0;
-  if (auto v = uri.GetInt("transports")) o.transports = static_cast<int>(*v);
+  if (auto v = uri.GetInt32("transports")) o.transports = *v;
+  if (auto v = uri.GetInt("prop")) o.prop = *v != 0;
   o.Validate();
   return o;
 }
@@ -85,6 +87,9 @@ void SimManipOptions::Validate() const {
          "x" + std::to_string(height_px));
   }
   if (!(fps >= 1.0 && fps <= 240.0)) Fail("sim-manip: fps must be in [1, 240], got " + std::to_string(fps));
+  if (prop && internal::IsBoardAction(action)) {
+    Fail("sim-manip: prop=1 needs a table action, got '" + action + "' (a whiteboard action)");
+  }
   if (transports < 0 || transports > 20) {
     Fail("sim-manip: transports must be in [0, 20], got " + std::to_string(transports));
   }
@@ -180,11 +185,14 @@ class SimManipScene::Impl {
 
     // Objects on the plane, away from the hand's working area.
     if (board_) {
-      boxes_.push_back({{-0.35, -0.85, 0.0}, {0.6, -0.8, 0.06}, {0.55, 0.55, 0.6}});  // marker tray
-      boxes_.push_back({{-0.35, 0.15, 0.0}, {-0.27, 0.23, 0.02}, {0.8, 0.2, 0.2}});   // magnet
+      boxes_.push_back({{-0.35, -0.85, 0.0}, {0.6, -0.8, 0.06}, {0.55, 0.55, 0.6}, "marker_tray"});
+      boxes_.push_back({{-0.35, 0.15, 0.0}, {-0.27, 0.23, 0.02}, {0.8, 0.2, 0.2}, "magnet"});
     } else {
-      boxes_.push_back({{-0.42, 0.15, 0.0}, {-0.34, 0.23, 0.12}, {0.2, 0.35, 0.8}});  // cup
-      boxes_.push_back({{0.3, 0.25, 0.0}, {0.45, 0.35, 0.04}, {0.3, 0.7, 0.3}});     // box
+      boxes_.push_back({{-0.42, 0.15, 0.0}, {-0.34, 0.23, 0.12}, {0.2, 0.35, 0.8}, "cup"});
+      boxes_.push_back({{0.3, 0.25, 0.0}, {0.45, 0.35, 0.04}, {0.3, 0.7, 0.3}, "box"});
+      // Behind the mouth position of eating/drinking (v 0.20-0.26 m, h 0.20-0.36 m) as seen from
+      // the camera (50 deg elevation): the raised hand covers part of its front and top.
+      if (o.prop) boxes_.push_back({{-0.05, 0.32, 0.0}, {0.05, 0.40, 0.12}, {0.75, 0.7, 0.2}, "prop"});
     }
 
     // Truth in the camera frame.
@@ -194,6 +202,14 @@ class SimManipScene::Impl {
     truth_.plane_camera << n_C, -n_C.dot(origin_C);
     if (truth_.plane_camera[3] < 0) truth_.plane_camera = -truth_.plane_camera;
     truth_.K = K_;
+    for (const Box& b : boxes_) {
+      SimObjectTruth t;
+      t.name = b.name;
+      t.size_m = b.hi - b.lo;
+      t.centre_camera_m = R_C_P * (0.5 * (b.lo + b.hi) - eye_);
+      t.axes_camera = R_C_P;
+      truth_.objects.push_back(t);
+    }
     for (const auto& p : path_) {
       truth_.hand_centre_camera_m.push_back(R_C_P * (Eigen::Vector3d(p.u_m, p.v_m, p.h_m) - eye_));
       truth_.hand_yaw_rad.push_back(p.yaw_rad);

@@ -49,7 +49,10 @@ struct LogEvent {
 /// completed event is flushed so a crash loses at most the event being written.
 class LogWriter {
  public:
-  /// @throws romo::Error when the file cannot be created.
+  /// Writes @p path.partial, renamed to @p path on Close. A @p path.partial already there was
+  /// left by a writer that was killed: it is moved to <stem>.interrupted-<k>.lcmlog (see
+  /// kept_interrupted()), never overwritten.
+  /// @throws romo::Error when the file cannot be created or the old one not moved aside.
   explicit LogWriter(const std::string& path, ImageEncoding encoding = ImageEncoding::kRaw);
   ~LogWriter();
   LogWriter(const LogWriter&) = delete;
@@ -67,6 +70,8 @@ class LogWriter {
   std::uint64_t events_written() const;
   std::uint64_t bytes_written() const;
   const std::string& path() const;
+  /// Where an interrupted recording found at @p path.partial was kept; "" when there was none.
+  const std::string& kept_interrupted() const;
 
  private:
   class Impl;

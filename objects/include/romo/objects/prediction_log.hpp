@@ -85,6 +85,8 @@ class PredictionCsvWriter {
   void Close();
   std::int64_t rows_written() const;
   const std::string& path() const;
+  /// Where a log found at @p path.partial (left by a killed writer) was kept; "" if none.
+  const std::string& kept_interrupted() const;
 
  private:
   class Impl;
