@@ -1,5 +1,6 @@
-// `romo segment`: ground removal, DFS blob segmentation and vertical boxes for one PCD cloud
-// (vehicle frame, z up), as text or JSON; optionally a top-view picture and one PCD per blob.
+// `romo segment`: ground removal, DFS blob segmentation, vertical boxes and their Atlas classes
+// for one PCD cloud (vehicle frame, z up), as text or JSON; optionally a top-view picture and one
+// PCD per blob.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,8 +13,10 @@
 
 #include "cli/command_registry.hpp"
 #include "romo/core/check.hpp"
+#include "romo/core/json.hpp"
 #include "romo/mapping/ground_removal.hpp"
 #include "romo/mapping/segmentation.hpp"
+#include "romo/objects/atlas.hpp"
 #include "romo/objects/box.hpp"
 #include "romo/stereo/pcd_io.hpp"
 
@@ -28,6 +31,7 @@ struct Options {
   float ground_tolerance_m = 0.1f;
   bool json = false;
   std::string out_dir;
+  std::string atlas;  // "" = objects::Atlas::DefaultPath()
 };
 
 struct BlobReport {
@@ -36,9 +40,11 @@ struct BlobReport {
   std::string cls;
 };
 
-// Hook for the objects module's classifier (Atlas size priors): until it exists every blob is
-// "unknown". TODO(objects): call the classifier here.
-std::string ClassifyBlob(const objects::Box3& /*box*/) { return "unknown"; }
+// The Atlas class of a blob's vertical box from its extents alone (no viewpoint: a cloud file
+// has none); "unknown" when no class's size priors explain it.
+std::string ClassifyBlob(const objects::Atlas& atlas, const objects::Box3& box) {
+  return atlas.classes()[static_cast<std::size_t>(atlas.Classify(box).class_index)].name;
+}
 
 std::string Num(double v) {
   if (!std::isfinite(v)) return "null";
@@ -99,6 +105,7 @@ void Run(const Options& o) {
   mapping::GroundRemovalParams gp;
   gp.height_tolerance_m = o.ground_tolerance_m;
   gp.Validate();
+  const objects::Atlas atlas = objects::Atlas::Load(o.atlas.empty() ? objects::Atlas::DefaultPath() : o.atlas);
 
   stereo::PcdLoadStats load_stats;
   const PointCloud cloud = stereo::LoadPcd(o.pcd, &load_stats);
@@ -110,7 +117,7 @@ void Run(const Options& o) {
     BlobReport r;
     r.indices = indices;
     r.box = objects::FitVerticalBox(cloud.xyz, indices, ground.plane.normal);
-    r.cls = ClassifyBlob(r.box);
+    r.cls = ClassifyBlob(atlas, r.box);
     blobs.push_back(std::move(r));
   }
   if (load_stats.dropped_non_finite > 0) {
@@ -138,8 +145,8 @@ void Run(const Options& o) {
     for (std::size_t b = 0; b < blobs.size(); ++b) {
       const auto& r = blobs[b];
       js << (b ? ", " : "") << "{\"points\": " << r.indices.size() << ", \"center\": " << Vec(r.box.center)
-         << ", \"size\": " << Vec(r.box.size) << ", \"yaw\": " << Num(r.box.yaw_rad) << ", \"class\": \""
-         << r.cls << "\"}";
+         << ", \"size\": " << Vec(r.box.size) << ", \"yaw\": " << Num(r.box.yaw_rad) << ", \"class\": "
+         << JsonString(r.cls) << "}";
     }
     js << "]}\n";
     std::fputs(js.str().c_str(), stdout);
@@ -172,6 +179,8 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--ground-tolerance", opts->ground_tolerance_m,
                   "points up to this height above the ground plane are removed, metres")
       ->capture_default_str();
+  cmd->add_option("--atlas", opts->atlas,
+                  "Atlas YAML with the classes' size priors (default config/atlas.yaml or $ROMO_ATLAS)");
   cmd->add_flag("--json", opts->json, "print one JSON object");
   cmd->add_option("--out", opts->out_dir, "folder for topview.png and blob_NNN.pcd");
   cmd->callback([opts] { Run(*opts); });
