@@ -1,7 +1,9 @@
 // `romo fuse --lcm-url URL`: mapping, objects and planning on the rig clouds that stereo workers
 // publish. Frames are assembled by stamp; a rig that has not arrived within --timeout-ms is
 // reported missing (sector not covered) and the frame goes on without it. Malformed messages
-// are counted and reported, never fatal.
+// are counted and reported, never fatal. GNSS fixes on ROMO_GNSS (the receiver's driver, or a
+// worker with --publish-gnss) give the geodetic outputs; each frame takes the newest fix at most
+// --gnss-max-age-ms older than it, and bridges gaps by odometry like a single process.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -21,6 +23,7 @@
 
 #include "cli/command_registry.hpp"
 #include "romo/core/check.hpp"
+#include "romo/drivers/recording.hpp"
 #include "romo/pipeline/outputs.hpp"
 #include "romo/pipeline/pipeline.hpp"
 #include "romo/planning_iface/lcm_bus.hpp"
@@ -46,6 +49,7 @@ struct FuseOptions {
   // (measured: 5 of 8 frames arrived, each with 1 of 6 rigs). 32 MB holds a few full-resolution
   // frames (6 x 3.6 MB); the kernel caps it at net.core.rmem_max.
   long long recv_buf_bytes = 32ll << 20;
+  int gnss_max_age_ms = 200;
 };
 
 // @p url with recv_buf_size=@p bytes added when it is udpm:// and sets none.
@@ -82,22 +86,22 @@ class Inbox {
  public:
   Inbox(const std::string& url, std::size_t max_message_bytes, std::size_t max_queued_bytes)
       : bus_(url), max_message_bytes_(max_message_bytes), max_queued_bytes_(max_queued_bytes) {
-    bus_.Subscribe(std::string(planning_iface::kRigCloudChannelPrefix) + "[0-9]+",
-                   [this](const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
-                     Received m;
-                     m.channel = channel;
-                     m.size = size;
-                     if (size <= max_message_bytes_) m.data.assign(data, data + size);
-                     std::lock_guard<std::mutex> lock(mutex_);
-                     if (queued_bytes_ + m.data.size() > max_queued_bytes_) {
-                       m.overflow = true;
-                       m.data.clear();
-                     }
-                     queued_bytes_ += m.data.size();
-                     queue_.push_back(std::move(m));
-                     ready_.notify_one();
-                   },
-                   kLcmQueueCapacity);
+    auto receive = [this](const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
+      Received m;
+      m.channel = channel;
+      m.size = size;
+      if (size <= max_message_bytes_) m.data.assign(data, data + size);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queued_bytes_ + m.data.size() > max_queued_bytes_) {
+        m.overflow = true;
+        m.data.clear();
+      }
+      queued_bytes_ += m.data.size();
+      queue_.push_back(std::move(m));
+      ready_.notify_one();
+    };
+    bus_.Subscribe(std::string(planning_iface::kRigCloudChannelPrefix) + "[0-9]+", receive, kLcmQueueCapacity);
+    bus_.Subscribe(drivers::kGnssChannel, receive, kLcmQueueCapacity);
     thread_ = std::thread([this] {
       try {
         while (!stop_) bus_.Handle(50);
@@ -152,10 +156,10 @@ void Fuse(const FuseOptions& o) {
   out.log_inputs = false;
   out.frame_pictures = !o.no_pictures;
   pipeline::OutputSink sink(calibration, out);
-  // Stereo workers carry odometry with each cloud but no GNSS fix: geodetic outputs (the WGS84
-  // column of the pedestrian predictions) are relative to lat 0, lon 0 and say so.
-  pipe.ReportEvent("fuse: no GNSS on the bus (stereo workers carry odometry only): geodetic outputs unavailable, "
-                   "WGS84 is relative to lat 0, lon 0");
+  // Recent fixes by stamp (a few seconds at any GNSS rate); the pipeline reports frames without one.
+  std::map<std::int64_t, drivers::GnssFix> fixes;
+  constexpr std::size_t kFixesKept = 256;
+  long long frames_with_fix = 0;
 
   struct Pending {
     Clock::time_point first_arrival;
@@ -188,6 +192,23 @@ void Fuse(const FuseOptions& o) {
     const std::string& channel = m.channel;
     const std::size_t size = m.size;
     last_message = Clock::now();
+    if (channel == drivers::kGnssChannel) {
+      if (m.overflow || size > o.max_message_bytes) {
+        pipe.CountMalformed();
+        pipe.ReportEvent("GNSS message on " + channel + " dropped (" + std::to_string(size) + " bytes, " +
+                         (m.overflow ? "receive queue full" : "oversized") + ")");
+        return;
+      }
+      try {
+        const drivers::GnssFix fix = drivers::DecodeGnssMessage(m.data.data(), size, channel);
+        fixes[fix.stamp_ns] = fix;
+        if (fixes.size() > kFixesKept) fixes.erase(fixes.begin());
+      } catch (const Error& e) {
+        pipe.CountMalformed();
+        pipe.ReportEvent(std::string("malformed message on ") + e.what());
+      }
+      return;
+    }
     if (m.overflow) {
       const int rig = std::atoi(channel.c_str() + std::string(planning_iface::kRigCloudChannelPrefix).size());
       pipe.CountDropped(rig);
@@ -241,7 +262,15 @@ void Fuse(const FuseOptions& o) {
   auto process = [&](std::map<std::int64_t, Pending>::iterator it) {
     std::vector<pipeline::RigInput> rigs;
     for (auto& [id, in] : it->second.rigs) rigs.push_back(std::move(in));
-    const auto result = pipe.ProcessClouds(it->first, it->second.sequence, rigs, it->second.vehicle, std::nullopt);
+    // The newest fix not after the frame, unless it is too old to place the vehicle.
+    std::optional<drivers::GnssFix> gnss;
+    auto fix = fixes.upper_bound(it->first);
+    if (fix != fixes.begin() &&
+        it->first - std::prev(fix)->first <= static_cast<std::int64_t>(o.gnss_max_age_ms) * 1000000) {
+      gnss = std::prev(fix)->second;
+      ++frames_with_fix;
+    }
+    const auto result = pipe.ProcessClouds(it->first, it->second.sequence, rigs, it->second.vehicle, gnss);
     sink.Write(nullptr, result, {});
     last_done_stamp = it->first;
     ++processed;
@@ -277,7 +306,8 @@ void Fuse(const FuseOptions& o) {
   while (!pending.empty() && (o.frames <= 0 || processed < o.frames)) process(pending.begin());
   // Faults found after the last frame (bad or late messages) still reach the status and summary.
   if (auto status = pipe.TakePendingStatus()) sink.WriteStatus(*status);
-  sink.Finish("\"late_clouds\": " + std::to_string(late) + ", \"geodetic\": false");
+  sink.Finish("\"late_clouds\": " + std::to_string(late) + ", \"frames_with_gnss\": " + std::to_string(frames_with_fix) +
+              ", \"geodetic\": " + (frames_with_fix > 0 ? "true" : "false"));
   std::fprintf(stderr, "romo fuse: %lld frames processed, %lld late clouds\n", processed, late);
 }
 
@@ -299,6 +329,10 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--recv-buf-bytes", opts->recv_buf_bytes,
                   "kernel UDP receive buffer to ask for on udpm:// (0 = the system default)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--gnss-max-age-ms", opts->gnss_max_age_ms,
+                  "a frame uses the newest ROMO_GNSS fix at most this much older than it (else: GNSS gap)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->callback([opts] { Fuse(*opts); });

@@ -1,5 +1,7 @@
 // `romo stereo-worker --rig K --source URI --lcm-url URL`: one rig's stereo in its own process,
-// publishing the rig's cloud (compact int16 mm encoding) on ROMO_RIG_CLOUD<K> for `romo fuse`.
+// publishing the rig's cloud (compact int16 mm encoding) on ROMO_RIG_CLOUD<K> for `romo fuse`, and
+// with --publish-gnss the source's GNSS fixes on ROMO_GNSS (replaying a recording over workers; on
+// the vehicle the GNSS receiver's driver publishes them).
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -9,6 +11,7 @@
 #include "cli/command_registry.hpp"
 #include "romo/core/check.hpp"
 #include "romo/drivers/frame_source.hpp"
+#include "romo/drivers/recording.hpp"
 #include "romo/pipeline/pipeline.hpp"
 #include "romo/planning_iface/lcm_bus.hpp"
 #include "romo/planning_iface/messages.hpp"
@@ -22,6 +25,7 @@ struct WorkerOptions {
   std::string source;
   std::string lcm_url;
   long long frames = 0;
+  bool publish_gnss = false;
 };
 
 void Work(const WorkerOptions& o) {
@@ -38,6 +42,8 @@ void Work(const WorkerOptions& o) {
   while (o.frames <= 0 || sent + missing < o.frames) {
     auto frames = source->Next();
     if (!frames) break;
+    // Before the cloud, so the fix is in when fuse completes the frame.
+    if (o.publish_gnss && frames->gnss) bus.Publish(drivers::kGnssChannel, drivers::EncodeGnssMessage(*frames->gnss));
     const drivers::StereoFrame* mine = nullptr;
     for (const auto& st : frames->stereo) {
       if (st.rig_id == o.rig) mine = &st;
@@ -75,6 +81,7 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--lcm-url", opts->lcm_url, "LCM URL (udpm://... inside netns-run, memq:// in-process)")
       ->required();
   cmd->add_option("--frames", opts->frames, "stop after this many frames (0 = until the source ends)");
+  cmd->add_flag("--publish-gnss", opts->publish_gnss, "also publish the source's GNSS fixes on ROMO_GNSS");
   cmd->callback([opts] { Work(*opts); });
 });
 

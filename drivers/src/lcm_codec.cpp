@@ -1,6 +1,8 @@
 #include "lcm_codec.hpp"
 
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <sys/stat.h>
 
 #include <opencv2/core.hpp>
@@ -314,6 +316,14 @@ GnssFix DecodeGnss(const std::vector<std::uint8_t>& data, const std::string& ori
   fix.altitude_m = msg.altitude_m;
   fix.horizontal_sigma_m = msg.horizontal_sigma_m;
   fix.valid = msg.valid;
+  // A fix said valid is used for the ENU origin and the WGS84 outputs: it must be a position.
+  if (fix.valid && !(std::abs(fix.latitude_deg) <= 90.0 && std::abs(fix.longitude_deg) <= 180.0 &&
+                     std::isfinite(fix.altitude_m) && fix.horizontal_sigma_m >= 0.0)) {
+    std::ostringstream what;
+    what << origin << ": gnss_fix_t is not a position: latitude " << fix.latitude_deg << " deg, longitude "
+         << fix.longitude_deg << " deg, altitude " << fix.altitude_m << " m, sigma " << fix.horizontal_sigma_m << " m";
+    Fail(what.str());
+  }
   *set_sequence = static_cast<std::uint64_t>(msg.frame_sequence);
   return fix;
 }
@@ -387,3 +397,14 @@ ReadResult EventFileReader::Next(LogEvent* event) {
 }
 
 }  // namespace romo::drivers::lcm_codec
+
+namespace romo::drivers {
+
+std::vector<std::uint8_t> EncodeGnssMessage(const GnssFix& fix) { return lcm_codec::EncodeGnss(fix, 0); }
+
+GnssFix DecodeGnssMessage(const std::uint8_t* data, std::size_t size, const std::string& origin) {
+  std::uint64_t sequence = 0;
+  return lcm_codec::DecodeGnss(std::vector<std::uint8_t>(data, data + size), origin, &sequence);
+}
+
+}  // namespace romo::drivers

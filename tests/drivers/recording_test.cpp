@@ -92,6 +92,34 @@ TEST(RecordingTest, ReadsLogsWrittenByBareLcmLogFile) {
   EXPECT_EQ(std::string(events[2].data.begin(), events[2].data.end()), "event 2");
 }
 
+TEST(RecordingTest, GnssMessagesRoundTripAndImpossibleFixesAreRefused) {
+  GnssFix fix;
+  fix.stamp_ns = 1'700'000'000'123'456'789;
+  fix.latitude_deg = 48.0833;
+  fix.longitude_deg = 11.2791;
+  fix.altitude_m = 600.5;
+  fix.horizontal_sigma_m = 0.02;
+  fix.valid = true;
+  const auto bytes = EncodeGnssMessage(fix);
+  const GnssFix back = DecodeGnssMessage(bytes.data(), bytes.size(), "bus");
+  EXPECT_EQ(back.stamp_ns, fix.stamp_ns);
+  EXPECT_EQ(back.latitude_deg, fix.latitude_deg);
+  EXPECT_EQ(back.longitude_deg, fix.longitude_deg);
+  EXPECT_EQ(back.altitude_m, fix.altitude_m);
+  EXPECT_TRUE(back.valid);
+  const std::string cut = test::ErrorOf([&] { DecodeGnssMessage(bytes.data(), bytes.size() - 3, "bus"); });
+  EXPECT_EQ(cut.rfind("bus", 0), 0u) << cut;
+  fix.latitude_deg = 200.0;
+  const auto impossible = EncodeGnssMessage(fix);
+  EXPECT_NE(test::ErrorOf([&] { DecodeGnssMessage(impossible.data(), impossible.size(), "bus"); })
+                .find("bus: gnss_fix_t is not a position: latitude 200 deg"),
+            std::string::npos);
+  // An invalid fix (no reception) carries whatever the receiver left there: not an error.
+  fix.valid = false;
+  const auto no_fix = EncodeGnssMessage(fix);
+  EXPECT_FALSE(DecodeGnssMessage(no_fix.data(), no_fix.size(), "bus").valid);
+}
+
 TEST(RecordingTest, UnknownSchemeListsTheKnownOnes) {
   try {
     OpenSource("tape://run.lcmlog");

@@ -20,6 +20,7 @@
 
 #include "hil_support.hpp"
 #include "romo/drivers/recording.hpp"
+#include "romo/objects/prediction_log.hpp"
 #include "romo/planning_iface/lcm_bus.hpp"
 #include "romo/planning_iface/messages.hpp"
 #include "status_listener.hpp"
@@ -47,6 +48,7 @@ struct Outputs {
   std::map<std::int64_t, pi::ObstacleList> obstacles;
   std::map<std::int64_t, pi::ParkingSlotReport> slots;
   std::map<std::int64_t, pi::PerceptionStatus> statuses;
+  std::vector<objects::Wgs84> prediction_origins;  // the ENU origin of every pedestrian prediction
 };
 
 Outputs ReadOutputs(const std::string& path) {
@@ -66,6 +68,10 @@ Outputs ReadOutputs(const std::string& path) {
       auto m = pi::DecodePerceptionStatus(e.data.data(), e.data.size(), &why);
       EXPECT_TRUE(m.has_value()) << why;
       if (m) out.statuses[m->frame_sequence] = *m;
+    } else if (e.channel == objects::kPedestrianPredictionChannel) {
+      for (const auto& p : objects::DecodePedestrianPredictions(e.data.data(), e.data.size())) {
+        out.prediction_origins.push_back(p.enu_origin);
+      }
     }
   }
   EXPECT_EQ(truncated_at, -1) << path;
@@ -87,13 +93,15 @@ std::unique_ptr<Background> StartFuse(const test::ScratchDir& dir, const std::st
   return fuse;
 }
 
+// With @p gnss_from_rig0 the first worker also publishes the recording's GNSS fixes.
 std::vector<std::unique_ptr<Background>> StartWorkers(const test::ScratchDir& dir, const std::string& url,
-                                                      const std::string& recording) {
+                                                      const std::string& recording, bool gnss_from_rig0 = false) {
   std::vector<std::unique_ptr<Background>> workers;
   for (int rig = 0; rig < kRigs; ++rig) {
     workers.push_back(std::make_unique<Background>(
         RomoBinary() + " stereo-worker --rig " + std::to_string(rig) + " --source log://" + recording +
-        " --lcm-url '" + url + "' 2>" + dir / ("worker" + std::to_string(rig) + ".err")));
+        " --lcm-url '" + url + "'" + (gnss_from_rig0 && rig == 0 ? " --publish-gnss" : "") + " 2>" +
+        dir / ("worker" + std::to_string(rig) + ".err")));
   }
   return workers;
 }
@@ -189,7 +197,7 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   // cores can start seconds apart.
   auto fuse = StartFuse(dir, url, "--frames " + std::to_string(kFrames) + " --timeout-ms 20000 --idle-exit 60");
   ASSERT_NE(fuse, nullptr);
-  auto workers = StartWorkers(dir, url, Recording());
+  auto workers = StartWorkers(dir, url, Recording(), /*gnss_from_rig0=*/true);
   ASSERT_TRUE(ExitedCleanly(fuse->Wait(120.0))) << test::ReadFile(dir / "fuse.err");
   for (int rig = 0; rig < kRigs; ++rig) {
     const std::string err = test::ReadFile(dir / ("worker" + std::to_string(rig) + ".err"));
@@ -279,20 +287,32 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
       if (!fused_matched[j]) ++(sb[j].feasible ? slot_presence_differences : gap_presence_differences);
     }
   }
-  // What fuse cannot do is said in its first status: no GNSS reaches it (geodetic outputs
-  // unavailable), and a kernel cap on its receive buffer below the 32 MB it asks for.
+  // A kernel cap on fuse's receive buffer below the 32 MB it asks for is said in its first status.
   const auto has_event = [&](const std::string& text) {
     for (const auto& e : fused.statuses.begin()->second.events) {
       if (e.find(text) != std::string::npos) return true;
     }
     return false;
   };
-  EXPECT_TRUE(has_event("geodetic outputs unavailable"));
   long long rmem_max = -1;
   std::sscanf(test::ReadFile("/proc/sys/net/core/rmem_max").c_str(), "%lld", &rmem_max);
   EXPECT_EQ(has_event("capped at " + std::to_string(rmem_max) + " bytes by net.core.rmem_max"),
             rmem_max >= 0 && rmem_max < (32ll << 20));
-  EXPECT_NE(test::ReadFile(dir / "fuse/summary.json").find("\"geodetic\": false"), std::string::npos);
+  // GNSS over the bus (rig 0's worker publishes the recording's fixes): every frame has its fix,
+  // and the geodetic outputs are the single process's: the same ENU origin (the first frame's
+  // fix) under every pedestrian prediction.
+  const std::string fuse_summary = test::ReadFile(dir / "fuse/summary.json");
+  EXPECT_NE(fuse_summary.find("\"frames_with_gnss\": " + std::to_string(kFrames)), std::string::npos) << fuse_summary;
+  EXPECT_NE(fuse_summary.find("\"geodetic\": true"), std::string::npos) << fuse_summary;
+  EXPECT_FALSE(has_event("no GNSS fix yet"));
+  ASSERT_FALSE(one.prediction_origins.empty());
+  ASSERT_FALSE(fused.prediction_origins.empty());
+  const objects::Wgs84 origin = one.prediction_origins.front();
+  EXPECT_GT(std::abs(origin.latitude_deg), 1.0) << "the recording's fixes, not a placeholder";
+  for (const auto& o : fused.prediction_origins) {
+    EXPECT_NEAR(o.latitude_deg, origin.latitude_deg, 1e-9);
+    EXPECT_NEAR(o.longitude_deg, origin.longitude_deg, 1e-9);
+  }
 
   // The recording's window must exercise the comparison: obstacles and a slot in it.
   ASSERT_GE(obstacles_compared, kFrames);
@@ -371,7 +391,10 @@ TEST_F(WorkersFuseHilTest, KilledWorkerLeavesItsSectorMissingAndFuseKeepsPublish
   // A frame without the rig can only be fused once the rig is gone.
   EXPECT_GE(after_kill, static_cast<std::size_t>(without_killed));
   EXPECT_TRUE(listener.HasEvent("rig 3 (rear) missing"));
+  // No worker publishes GNSS here: said once, and the summary says geodetic outputs are off.
+  EXPECT_TRUE(listener.HasEvent("no GNSS fix yet: WGS84 relative to lat 0, lon 0"));
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
+  EXPECT_NE(summary.find("\"geodetic\": false"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"frames_with_missing_rigs\": " + std::to_string(without_killed)), std::string::npos)
       << summary;
   std::printf("FIGURE worker_killed: rig %d killed after publishing %d clouds (fuse had published %zu frames); "
@@ -410,7 +433,7 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
   ASSERT_NE(fuse, nullptr);
   StatusListener listener(ListenerUrl(7813));
   pi::LcmBus bus(url);
-  constexpr int kInjectedFrames = 6, kPoints = 400, kBadPerFrame = 4;
+  constexpr int kInjectedFrames = 6, kPoints = 400, kBadPerFrame = 4, kBadGnss = 2;
   for (int k = 0; k < kInjectedFrames; ++k) {
     const std::int64_t stamp = (k + 1) * 100000000LL;
     // Four bad messages per frame, before its good clouds: random bytes, a cut message, a cloud
@@ -425,6 +448,15 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     const auto oversized = RigCloudMessage(0, stamp, k, 30000);
     ASSERT_GT(oversized.size(), kLimit);
     bus.Publish(pi::RigCloudChannel(0), oversized);
+    if (k == 0) {
+      // GNSS: random bytes, and a fix said valid at latitude 200 deg.
+      bus.Publish(drivers::kGnssChannel, noise);
+      drivers::GnssFix impossible;
+      impossible.stamp_ns = stamp;
+      impossible.latitude_deg = 200.0;
+      impossible.valid = true;
+      bus.Publish(drivers::kGnssChannel, drivers::EncodeGnssMessage(impossible));
+    }
     for (int rig = 0; rig < kRigs; ++rig) bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints));
     // No lock-step with fuse: the bursts come as fast as this thread can send them.
   }
@@ -450,13 +482,15 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     for (const auto& rig : s.rigs) EXPECT_EQ(rig.points, kPoints) << "frame " << k << " rig " << rig.rig_id;
     // The bad messages sent before frame k's clouds are counted by the time it is processed
     // (later ones may be too: fuse takes whatever has arrived before fusing).
-    EXPECT_GE(s.malformed_messages, static_cast<std::int64_t>(kBadPerFrame * (k + 1)));
+    EXPECT_GE(s.malformed_messages, static_cast<std::int64_t>(kBadPerFrame * (k + 1) + kBadGnss));
   }
-  const int injected = kBadPerFrame * kInjectedFrames + kTrailing;
+  const int injected = kBadPerFrame * kInjectedFrames + kBadGnss + kTrailing;
   EXPECT_EQ(last.malformed_messages, injected);
   // Each kind rejected with its reason, once per frame.
-  int oversized = 0, undecodable2 = 0, cut3 = 0, wrong_channel4 = 0;
+  int oversized = 0, undecodable2 = 0, cut3 = 0, wrong_channel4 = 0, bad_gnss = 0, impossible_fix = 0;
   for (const auto& e : listener.events()) {
+    bad_gnss += e.find("malformed message on ROMO_GNSS: ") != std::string::npos;
+    impossible_fix += e.find("gnss_fix_t is not a position: latitude 200 deg") != std::string::npos;
     oversized += e.find("oversized message on ROMO_RIG_CLOUD0") != std::string::npos &&
                  e.find(std::to_string(kLimit)) != std::string::npos;
     undecodable2 += e.find("malformed message on ROMO_RIG_CLOUD2: ") != std::string::npos;
@@ -468,6 +502,8 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
   EXPECT_EQ(undecodable2, kInjectedFrames + 1);
   EXPECT_EQ(cut3, kInjectedFrames);
   EXPECT_EQ(wrong_channel4, kInjectedFrames);
+  EXPECT_EQ(bad_gnss, kBadGnss);
+  EXPECT_EQ(impossible_fix, 1);
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
   EXPECT_NE(summary.find("\"malformed_messages\": " + std::to_string(injected)), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"frames_with_missing_rigs\": 0"), std::string::npos) << summary;

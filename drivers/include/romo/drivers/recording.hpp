@@ -113,6 +113,13 @@ class LogReader : public FrameSource {
   std::unique_ptr<Impl> impl_;
 };
 
+/// One GNSS fix as its ROMO_GNSS message (romo_lcm.gnss_fix_t), for processes that pass fixes
+/// on a bus (a stereo worker to `romo fuse`).
+std::vector<std::uint8_t> EncodeGnssMessage(const GnssFix& fix);
+/// @throws romo::Error naming @p origin when the bytes are no gnss_fix_t or a valid fix is no
+/// position (latitude beyond +-90 deg, longitude beyond +-180 deg, non-finite values).
+GnssFix DecodeGnssMessage(const std::uint8_t* data, std::size_t size, const std::string& origin);
+
 /// Reads every complete event of a log (for `romo info`, tests); stops at a truncated tail.
 /// @param truncated_at set to the byte offset of the cut, or -1 when the file is complete.
 std::vector<LogEvent> ReadAllEvents(const std::string& path, std::int64_t* truncated_at);
