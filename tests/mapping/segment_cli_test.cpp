@@ -24,16 +24,27 @@ int Count(const std::string& s, const std::string& what) {
   return n;
 }
 
-TEST(SegmentCliTest, JsonReportsGroundPlaneAndOneBlobPerObject) {
-  test::ScratchDir dir;
+// Both scenes: a 24 m ground patch at 300 points/m^2 with 1 cm noise, and this car on it.
+SyntheticSceneParams PatchParams() {
   SyntheticSceneParams sp;
   sp.density_per_m2 = 300.f;
   sp.ground_half_extent_m = 12.f;
   sp.noise_m = 0.01f;
+  return sp;
+}
+
+SceneObject Car() {
   SceneObject car;
   car.center_xy = {6.f, 3.f};
   car.size = {4.5f, 1.8f, 1.5f};
   car.yaw_rad = 0.2f;
+  return car;
+}
+
+TEST(SegmentCliTest, JsonReportsGroundPlaneAndOneBlobPerObject) {
+  test::ScratchDir dir;
+  const SyntheticSceneParams sp = PatchParams();
+  const SceneObject car = Car();
   SceneObject ped;
   ped.shape = SceneObject::Shape::kCylinder;
   ped.center_xy = {4.f, -3.f};
@@ -64,15 +75,9 @@ TEST(SegmentCliTest, JsonReportsGroundPlaneAndOneBlobPerObject) {
 TEST(SegmentCliTest, JsonBoxesAndAtlasClassesOfACarAndAPedestrian) {
   // A car and a pedestrian-sized box on a 24 m ground patch, 300 points/m^2, 1 cm noise.
   test::ScratchDir dir;
-  SyntheticSceneParams sp;
-  sp.density_per_m2 = 300.f;
-  sp.ground_half_extent_m = 12.f;
-  sp.noise_m = 0.01f;
+  SyntheticSceneParams sp = PatchParams();
   sp.seed = 21;
-  SceneObject car;
-  car.center_xy = {6.f, 3.f};
-  car.size = {4.5f, 1.8f, 1.5f};
-  car.yaw_rad = 0.2f;
+  const SceneObject car = Car();
   SceneObject ped;
   ped.center_xy = {4.f, -3.f};
   ped.size = {0.6f, 0.4f, 1.7f};
