@@ -123,5 +123,7 @@ printf '%s' 'sim://parking' > "$out/sim_uri/sim_plain"
 printf '%s' 'sim://parking?aa=2&noise=1.5&threads=2&first=40&rate_hz=5&distortion=0&start_ns=0' > "$out/sim_uri/sim_options"
 printf '%s' 'log://run.lcmlog?loop=1&pacing=realtime&seek_s=2.5' > "$out/sim_uri/log"
 printf '%s' 'rgbd:///data/tum?depth_scale=5000&max_dt_s=0.02' > "$out/sim_uri/rgbd"
+printf '%s' 'sim-manip://writing?seed=3&frames=60&width=320&height=240&fps=30&noise=1&transports=1' > "$out/sim_uri/sim_manip"
+printf '%s' 'log://x.lcmlog?loop=0&pacing=fast&seek_s=0' > "$out/sim_uri/log_options"
 
 du -sh "$out"/*
