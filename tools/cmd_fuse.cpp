@@ -253,7 +253,7 @@ void Fuse(const FuseOptions& o) {
     if (rc->vehicle) p.vehicle = rc->vehicle;
     pipeline::RigInput in;
     in.rig_id = rc->rig_id;
-    in.stamp_ns = rc->stamp_ns;
+    in.stamp_ns = rc->capture_stamp_ns;  // motion-compensated to the frame's stamp
     in.cloud = std::move(rc->cloud);
     in.stereo_ms = rc->stereo_ms;
     p.rigs[in.rig_id] = std::move(in);

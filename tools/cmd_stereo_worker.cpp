@@ -60,6 +60,7 @@ void Work(const WorkerOptions& o) {
     planning_iface::RigCloud rc;
     rc.stamp_ns = frames->stamp_ns;
     rc.frame_sequence = static_cast<std::int64_t>(frames->sequence);
+    rc.capture_stamp_ns = in->stamp_ns;
     rc.rig_id = o.rig;
     rc.cloud = std::move(in->cloud);
     rc.stereo_ms = in->stereo_ms;

@@ -76,7 +76,7 @@ bool WalkPerceptionStatus(LcmWalker& w) {
 
 bool WalkRigCloud(LcmWalker& w) {
   std::int32_t points = 0, coords = 0;
-  return w.Skip(8 + 16 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
+  return w.Skip(8 + 24 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
          w.Skip(2 * static_cast<std::size_t>(coords)) && w.Skip(3 * static_cast<std::size_t>(points)) &&
          w.Skip(8 + 1 + 8 * 9);
 }
@@ -414,6 +414,7 @@ std::vector<std::uint8_t> Encode(const RigCloud& rc, double scale_m) {
   romo_lcm::rig_cloud_t msg;
   msg.stamp_ns = rc.stamp_ns;
   msg.frame_sequence = rc.frame_sequence;
+  msg.capture_stamp_ns = rc.capture_stamp_ns;
   msg.rig_id = rc.rig_id;
   msg.scale_m = static_cast<float>(scale_m);
   msg.stereo_ms = static_cast<float>(rc.stereo_ms);
@@ -476,6 +477,15 @@ std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::
     SetWhy(why, "rig_cloud_t.scale_m = " + std::to_string(msg.scale_m) + " not in (0, 1] m");
     return std::nullopt;
   }
+  // Overflow-free |capture - stamp| <= the limit.
+  const bool capture_near = msg.capture_stamp_ns >= msg.stamp_ns
+                                ? msg.capture_stamp_ns - kMaxCaptureOffsetNs <= msg.stamp_ns
+                                : msg.stamp_ns - kMaxCaptureOffsetNs <= msg.capture_stamp_ns;
+  if (!capture_near) {
+    SetWhy(why, "rig_cloud_t.capture_stamp_ns = " + std::to_string(msg.capture_stamp_ns) +
+                    " is more than 1 s from the frame's stamp_ns = " + std::to_string(msg.stamp_ns));
+    return std::nullopt;
+  }
   for (std::int16_t s : msg.sigma_q) {
     if (s < 0) {
       SetWhy(why, "rig_cloud_t.sigma_q has a negative value " + std::to_string(s));
@@ -501,6 +511,7 @@ std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::
   }
   out.stamp_ns = msg.stamp_ns;
   out.frame_sequence = msg.frame_sequence;
+  out.capture_stamp_ns = msg.capture_stamp_ns;
   out.rig_id = msg.rig_id;
   out.dropped_out_of_range = msg.dropped_out_of_range;
   out.stereo_ms = msg.stereo_ms;

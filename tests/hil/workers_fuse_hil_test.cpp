@@ -408,6 +408,7 @@ std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std
   pi::RigCloud cloud;
   cloud.rig_id = rig_id;
   cloud.stamp_ns = stamp_ns;
+  cloud.capture_stamp_ns = stamp_ns;
   cloud.frame_sequence = sequence;
   const double yaw = rig_id * 1.047;
   for (int i = 0; i < points; ++i) {

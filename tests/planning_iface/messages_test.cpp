@@ -2,6 +2,7 @@
 #include "romo/planning_iface/messages.hpp"
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <optional>
 
@@ -125,7 +126,8 @@ TEST(MessagesTest, PerceptionStatusRoundTrip) {
 TEST(MessagesTest, RigCloudQuantisedToMillimetresAndOutOfRangeCounted) {
   RigCloud in;
   in.rig_id = 4;
-  in.stamp_ns = 77;
+  in.stamp_ns = 1'000'000'077;
+  in.capture_stamp_ns = in.stamp_ns - 30'000'000;  // captured 30 ms before its set's stamp
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-30.f, 30.f);
   for (int i = 0; i < 1001; ++i) in.cloud.PushBack({u(rng), u(rng), u(rng)}, 0.01f * (i % 50), float(i % 256));
@@ -137,6 +139,8 @@ TEST(MessagesTest, RigCloudQuantisedToMillimetresAndOutOfRangeCounted) {
   const auto out = DecodeRigCloud(bytes.data(), bytes.size(), &why);
   ASSERT_TRUE(out) << why;
   EXPECT_EQ(out->rig_id, 4);
+  EXPECT_EQ(out->stamp_ns, in.stamp_ns);
+  EXPECT_EQ(out->capture_stamp_ns, in.capture_stamp_ns);
   ASSERT_EQ(out->cloud.size(), 1001u);
   EXPECT_EQ(out->dropped_out_of_range, 1);
   for (std::size_t i = 0; i < out->cloud.size(); ++i) {
@@ -166,9 +170,19 @@ TEST(MessagesTest, MalformedMessagesAreRejectedWithAReason) {
   RigCloud rc;
   rc.cloud.PushBack({1, 2, 3});
   auto cloud_bytes = Encode(rc);
-  cloud_bytes[32] = 0x7f;
+  cloud_bytes[40] = 0x7f;  // after hash, stamp, sequence, capture stamp, rig id, scale
   EXPECT_FALSE(DecodeRigCloud(cloud_bytes.data(), cloud_bytes.size(), &why));
   EXPECT_NE(why.find("num_points"), std::string::npos) << why;
+  // A rig said to have captured 2 s away from its frame set's stamp.
+  rc.stamp_ns = 5'000'000'000;
+  rc.capture_stamp_ns = 3'000'000'000;
+  const auto far_bytes = Encode(rc);
+  EXPECT_FALSE(DecodeRigCloud(far_bytes.data(), far_bytes.size(), &why));
+  EXPECT_NE(why.find("capture_stamp_ns = 3000000000 is more than 1 s from the frame's stamp_ns"), std::string::npos)
+      << why;
+  rc.capture_stamp_ns = std::numeric_limits<std::int64_t>::min();  // no overflow in the check
+  const auto min_bytes = Encode(rc);
+  EXPECT_FALSE(DecodeRigCloud(min_bytes.data(), min_bytes.size(), &why));
   // A string length of 0 (LCM always counts the NUL): the generated decoder would assign
   // size_t(-1) bytes; the shared walk rejects it first. Offset 32: hash, stamp, sequence,
   // num_obstacles, track_id.

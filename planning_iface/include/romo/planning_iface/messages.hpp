@@ -84,14 +84,20 @@ struct PerceptionStatus {
 
 /// One rig's cloud as a stereo worker publishes it (vehicle frame).
 struct RigCloud {
-  std::int64_t stamp_ns = 0;
+  std::int64_t stamp_ns = 0;  ///< the frame set's (frames are assembled by it)
   std::int64_t frame_sequence = 0;
+  /// The rig's own capture instant: rigs of one set may be up to half a frame period apart, and
+  /// fusion motion-compensates each to the set's stamp. Within kMaxCaptureOffsetNs of stamp_ns.
+  std::int64_t capture_stamp_ns = 0;
   int rig_id = 0;
   PointCloud cloud;
   int dropped_out_of_range = 0;  ///< points the compact encoding could not hold
   double stereo_ms = 0.0;
   std::optional<drivers::VehicleState> vehicle;  ///< odometry of the frame, when known
 };
+
+/// How far a rig's capture may lie from its frame set's stamp in a valid RigCloud.
+inline constexpr std::int64_t kMaxCaptureOffsetNs = 1'000'000'000;
 
 std::vector<std::uint8_t> Encode(const ObstacleList& list);
 std::vector<std::uint8_t> Encode(const ParkingSlotReport& report);
