@@ -191,8 +191,9 @@ class SimManipScene::Impl {
       boxes_.push_back({{-0.42, 0.15, 0.0}, {-0.34, 0.23, 0.12}, {0.2, 0.35, 0.8}, "cup"});
       boxes_.push_back({{0.3, 0.25, 0.0}, {0.45, 0.35, 0.04}, {0.3, 0.7, 0.3}, "box"});
       // Behind the mouth position of eating/drinking (v 0.20-0.26 m, h 0.20-0.36 m) as seen from
-      // the camera (50 deg elevation): the raised hand covers part of its front and top.
-      if (o.prop) boxes_.push_back({{-0.05, 0.32, 0.0}, {0.05, 0.40, 0.12}, {0.75, 0.7, 0.2}, "prop"});
+      // the camera (50 deg elevation): the raised hand covers part of its front and top (10-30 %
+      // of its pixels in 15-30 of drinking's 210 frames).
+      if (o.prop) boxes_.push_back({{0.01, 0.32, 0.0}, {0.11, 0.40, 0.12}, {0.75, 0.7, 0.2}, "prop"});
     }
 
     // Truth in the camera frame.
