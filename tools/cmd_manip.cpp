@@ -190,7 +190,8 @@ int RunEval(const EvalArgs& a) {
     }
   }
   sim_manip::ConfusionMatrix cm;
-  const indoor_manip::ManipParams params;
+  indoor_manip::ManipParams params;
+  params.object_map = false;  // the labels do not depend on the blob map; it would only cost time
   Progress progress("eval manip", actions.size() * static_cast<std::uint64_t>(s1 - s0 + 1));
   std::uint64_t done = 0;
   bool header = false;

@@ -26,6 +26,26 @@ std::string Arr(const Vec& v) {
 
 std::string Str(const std::string& s) { return "\"" + JsonEscape(s) + "\""; }
 
+std::string BoxJson(const objects::Box3& b) {
+  return "{\"center_m\": " + Arr(b.center) + ", \"size_m\": " + Arr(b.size) + ", \"axes\": [" +
+         Arr(b.axes.col(0)) + ", " + Arr(b.axes.col(1)) + ", " + Arr(b.axes.col(2)) + "]}";
+}
+
+// The blob map's view of an object: completed box (highest-confidence points), points per
+// confidence band, mean confidence.
+std::string CompletedJson(const CompletedObject& c) {
+  std::string s = "{\"blob_id\": " + std::to_string(c.blob_id) + ", \"points\": " + std::to_string(c.points) +
+                  ", \"mean_confidence\": " + Num(c.mean_confidence) + ", \"points_per_band\": [";
+  for (std::size_t i = 0; i < c.points_per_band.size(); ++i) {
+    s += std::string(i ? ", " : "") + "{\"cv_from\": " + Num(kConfidenceBandLow[i]) + ", \"points\": " +
+         std::to_string(c.points_per_band[i]) + "}";
+  }
+  s += "], \"completed_points\": " + std::to_string(c.completed_points) + ", \"completed_box\": " +
+       (c.completed_box ? BoxJson(*c.completed_box) : std::string("null")) + ", \"completed_pca_box\": " +
+       (c.completed_pca_box ? BoxJson(*c.completed_pca_box) : std::string("null")) + "}";
+  return s;
+}
+
 }  // namespace
 
 KnowledgeContainer BuildKnowledge(const ManipResult& r, const ObjectFunctionAtlas& atlas) {
@@ -33,6 +53,8 @@ KnowledgeContainer BuildKnowledge(const ManipResult& r, const ObjectFunctionAtla
   kc.physics.plane = r.plane;
   kc.physics.plane_inliers = r.scene.plane_inliers;
   kc.physics.objects = r.scene.objects;
+  kc.physics.completed = r.completed_objects;
+  kc.physics.map = r.object_map;
   auto& m = kc.motions;
   m.frames = r.frames;
   m.frames_with_hand = r.frames - r.frames_without_hand;
@@ -60,13 +82,25 @@ std::string KnowledgeContainer::ToJson() const {
   s << "    \"objects\": [";
   for (std::size_t i = 0; i < physics.objects.size(); ++i) {
     const auto& o = physics.objects[i];
+    std::string completed = "null";
+    for (const auto& c : physics.completed) {
+      if (c.first_frame_object == o.id) completed = CompletedJson(c);
+    }
     s << (i ? ",\n      " : "\n      ") << "{\"id\": " << o.id << ", \"points\": " << o.points
-      << ", \"is_hand\": " << (o.is_hand ? "true" : "false") << ", \"pca_box\": {\"center_m\": "
-      << Arr(o.box.center) << ", \"size_m\": " << Arr(o.box.size) << ", \"axes\": ["
-      << Arr(o.box.axes.col(0)) << ", " << Arr(o.box.axes.col(1)) << ", " << Arr(o.box.axes.col(2))
-      << "]}, \"height_above_plane_m\": " << Num(o.height_above_plane_m) << "}";
+      << ", \"is_hand\": " << (o.is_hand ? "true" : "false") << ", \"pca_box\": " << BoxJson(o.box)
+      << ", \"height_above_plane_m\": " << Num(o.height_above_plane_m) << ", \"completed\": " << completed << "}";
   }
-  s << "]\n  },\n";
+  s << "],\n    \"later_objects\": [";
+  bool first = true;
+  for (const auto& c : physics.completed) {
+    if (c.first_frame_object >= 0) continue;
+    s << (first ? "\n      " : ",\n      ") << CompletedJson(c);
+    first = false;
+  }
+  const auto& st = physics.map;
+  s << "],\n    \"blob_map\": {\"frames_fused\": " << st.frames_fused << ", \"ego_failures\": " << st.ego_failures
+    << ", \"rekeys\": " << st.rekeys << ", \"matched\": " << st.matched << ", \"unpredicted\": " << st.unpredicted
+    << ", \"unobserved\": " << st.unobserved << "}\n  },\n";
   const auto& m = motions;
   s << "  \"motions\": {\n    \"frames\": " << m.frames << ", \"frames_with_hand\": " << m.frames_with_hand
     << ", \"duration_s\": " << Num(m.duration_s) << ", \"hand_path_length_m\": " << Num(m.hand_path_length_m)

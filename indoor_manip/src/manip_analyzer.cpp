@@ -15,13 +15,16 @@ void ManipParams::Validate() const {
   scene.Validate();
   odometry.Validate();
   icp.Validate();
+  map.Validate();
   if (max_lost_frames < 0) Fail("max_lost_frames must be >= 0, got " + std::to_string(max_lost_frames));
 }
 
 class ManipAnalyzer::Impl {
  public:
   Impl(const InteractionPlane& plane, const DepthIntrinsics& k, const ManipParams& params)
-      : plane_(plane), k_(k), params_(params), kf_(params.kalman) {}
+      : plane_(plane), k_(k), params_(params), kf_(params.kalman) {
+    if (params.object_map) map_ = std::make_unique<ObjectMap>(k, plane, params.map, params.odometry);
+  }
 
   std::optional<HandBlob> Add(const RgbdImage& image, cv::Point seed) {
     const double t = image.stamp_ns * 1e-9;
@@ -40,6 +43,7 @@ class ManipAnalyzer::Impl {
       scene_ = SegmentSceneObjects(image, k_, plane_, blob->seed, params_.scene);
       first_image_ = image;
       s.predicted_m = blob->centroid_m;
+      if (map_) map_->Add(image, scene_);
     } else {
       if (lost_ > params_.max_lost_frames) {
         ++without_hand_;
@@ -47,6 +51,14 @@ class ManipAnalyzer::Impl {
       }
       s.predicted_m = kf_.Predict(t - last_t_);
       blob = FindHandNear(image, k_, s.predicted_m, &plane_, params_.hand);
+      if (map_) {
+        // Without the hand found its blob cannot be told from the objects': not fused.
+        if (blob && map_->NextFrameIsDue()) {
+          map_->Add(image, SegmentSceneObjects(image, k_, plane_, blob->seed, params_.scene));
+        } else {
+          map_->Skip();
+        }
+      }
     }
     if (blob) {
       s.measured = true;
@@ -103,6 +115,10 @@ class ManipAnalyzer::Impl {
     r.decision = ClassifyAction(r.features, params_.thresholds);
     r.locations = FindLocationAreas(r.fingerprint, params_.location);
     r.scene = scene_;
+    if (map_) {
+      r.completed_objects = map_->Completed();
+      r.object_map = map_->stats();
+    }
     if (params_.object_motions && frames_ > 1) {
       const SceneGeometry last = SegmentSceneObjects(last_image_, k_, plane_, cv::Point(-1, -1), params_.scene);
       r.object_motions = EstimateObjectMotions(first_image_, scene_, last_image_, last, k_, params_.odometry, params_.icp);
@@ -117,6 +133,7 @@ class ManipAnalyzer::Impl {
   HandKalmanFilter kf_;
   std::vector<PathSample> path_;
   SceneGeometry scene_;
+  std::unique_ptr<ObjectMap> map_;
   RgbdImage first_image_, last_image_;
   std::vector<Eigen::Vector3d> rotation_;
   std::optional<HandBlob> prev_blob_;

@@ -252,20 +252,47 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
       fresh_merged[m.fi] = 1;
       ++out.matched;
     }
-    // Unmatched points of the fresh blobs fused here are unpredicted observations: added.
+    // Unmatched points of the fresh blobs fused here are unpredicted observations: added, unless
+    // a stored point of this blob in the pixel neighbourhood lies within the gate (it matched a
+    // neighbouring observation): the surface is already there, and a copy would only hide it in
+    // the next frame's z-buffer and never gain support.
+    std::vector<std::pair<int, Eigen::Index>> added;
     for (std::size_t i = 0; i < fresh.size(); ++i) {
       if (!candidate[i] || !fresh_merged[i]) continue;
       for (Eigen::Index q = 0; q < fresh[i].xyz_world.cols(); ++q) {
         if (fresh_used[i][q]) continue;
         fresh_used[i][q] = 1;
-        blob.xyz_world.conservativeResize(3, blob.xyz_world.cols() + 1);
-        blob.xyz_world.col(blob.xyz_world.cols() - 1) = fresh[i].xyz_world.col(q);
-        blob.cov_world.push_back(fresh[i].cov_world[q]);
-        PointEvidence e;
-        UpdateEvidence(Visibility::kUnpredictedObservation, &e);
-        blob.evidence.push_back(e);
-        ++out.unpredicted;
+        const Eigen::Vector3d& x = fresh[i].xyz_world.col(q);
+        const Projection pr = Project(cam, T_cam_world, x);
+        bool redundant = false;
+        for (int dv = -r; dv <= r && !redundant && pr.u >= 0; ++dv) {
+          for (int du = -r; du <= r && !redundant; ++du) {
+            const int u = pr.u + du, v = pr.v + dv;
+            if (u < 0 || v < 0 || u >= w || v >= h) continue;
+            const auto [sj, sq] = zbuf[static_cast<std::size_t>(v) * w + u];
+            if (sj != j) continue;
+            const Eigen::Vector3d nu = x - blob.xyz_world.col(sq);
+            const Eigen::Matrix3d S = blob.cov_world[sq] + fresh[i].cov_world[q];
+            redundant = nu.dot(S.ldlt().solve(nu)) < params_.chi2_gate;
+          }
+        }
+        if (redundant) {
+          ++out.redundant;
+          continue;
+        }
+        added.emplace_back(static_cast<int>(i), q);
       }
+    }
+    const Eigen::Index n0 = blob.xyz_world.cols();
+    blob.xyz_world.conservativeResize(3, n0 + static_cast<Eigen::Index>(added.size()));
+    for (std::size_t a = 0; a < added.size(); ++a) {
+      const auto [i, q] = added[a];
+      blob.xyz_world.col(n0 + static_cast<Eigen::Index>(a)) = fresh[i].xyz_world.col(q);
+      blob.cov_world.push_back(fresh[i].cov_world[q]);
+      PointEvidence e;
+      UpdateEvidence(Visibility::kUnpredictedObservation, &e);
+      blob.evidence.push_back(e);
+      ++out.unpredicted;
     }
   }
   // Fresh blobs that matched nothing become new stored blobs.

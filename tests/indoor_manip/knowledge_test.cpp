@@ -166,6 +166,26 @@ TEST(KnowledgeTest, ContainerHoldsPlaneObjectsWithPcaBoxesAreasAndAtlasFunctions
   // cup's height (12 cm) and its diagonal (sqrt(8^2 + 8^2 + 12^2) = 16.5 cm), +-1 cm noise.
   EXPECT_GT(cup->box.size.x(), 0.11);
   EXPECT_LT(cup->box.size.x(), 0.175);
+  // The blob map over the frames: every second frame with the hand found is fused, and the cup
+  // carries the completed box of its highest-confidence points, standing on the table.
+  std::printf("blob map: %d frames fused, %d without ego-motion\n", kc.physics.map.frames_fused,
+              kc.physics.map.ego_failures);
+  EXPECT_GE(kc.physics.map.frames_fused, o.frames / 2 - 5);
+  const auto cup_map = std::find_if(kc.physics.completed.begin(), kc.physics.completed.end(),
+                                    [&](const CompletedObject& c) { return c.first_frame_object == cup->id; });
+  ASSERT_NE(cup_map, kc.physics.completed.end());
+  ASSERT_TRUE(cup_map->completed_box.has_value());
+  const Eigen::Vector3f cup_size = cup_map->completed_box->size;
+  std::printf("cup completed box %.3f x %.3f x %.3f m from %d of %d points, mean CV %.3f, bands %d %d %d %d\n",
+              cup_size.x(), cup_size.y(), cup_size.z(), cup_map->completed_points, cup_map->points,
+              cup_map->mean_confidence, cup_map->points_per_band[0], cup_map->points_per_band[1],
+              cup_map->points_per_band[2], cup_map->points_per_band[3]);
+  // 8 x 8 cm footprint, 10 cm above the 2 cm foreground height; 1 cm for mixed pixels at edges.
+  constexpr float kCupTolM = 0.01f;
+  EXPECT_NEAR(cup_size.x(), 0.08f, kCupTolM);
+  EXPECT_NEAR(cup_size.y(), 0.08f, kCupTolM);
+  EXPECT_NEAR(cup_size.z(), 0.10f, kCupTolM);
+  EXPECT_GT(cup_map->points_per_band[3], cup_map->points / 2);
   // Motions and locations: one transport between two areas.
   EXPECT_EQ(kc.motions.transports.size(), 1u);
   EXPECT_EQ(kc.locations.areas.size(), 2u);
@@ -176,7 +196,8 @@ TEST(KnowledgeTest, ContainerHoldsPlaneObjectsWithPcaBoxesAreasAndAtlasFunctions
   for (const auto& f : kc.action.functions) EXPECT_EQ(f.label, kc.action.label);
   const std::string json = kc.ToJson();
   for (const char* key : {"\"physics\"", "\"motions\"", "\"locations\"", "\"action\"", "\"pca_box\"",
-                          "\"functions\"", "\"transports\""}) {
+                          "\"functions\"", "\"transports\"",
+                          "\"completed_box\"", "\"points_per_band\"", "\"mean_confidence\"", "\"blob_map\""}) {
     EXPECT_NE(json.find(key), std::string::npos) << key;
   }
 }

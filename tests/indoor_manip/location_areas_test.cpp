@@ -101,7 +101,9 @@ TEST(LocationAreasTest, SimulatedTransportsFoundAsAreasAtTheTrueSpots) {
       const sim_manip::SimManipScene scene(o);
       const auto& truth = scene.truth().work_area_centres_camera_m;
       ASSERT_EQ(truth.size(), 2u);
-      const ManipResult r = sim_manip::AnalyzeSimManip(o, ManipParams{});
+      ManipParams params;
+      params.object_map = false;  // locations only
+      const ManipResult r = sim_manip::AnalyzeSimManip(o, params);
       const auto& loc = r.locations;
       std::printf("%s seed %d: %zu areas, %zu transports, %d stays\n", action, seed, loc.areas.size(),
                   loc.transports.size(), loc.stays);

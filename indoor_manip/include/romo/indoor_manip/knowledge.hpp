@@ -1,7 +1,7 @@
 #pragma once
 /// The knowledge container (dissertation Sec. 4.1.1, Fig. 4.1): what the geometric layer and the
 /// plugin know about the scene and the action, in three areas — physics (the interaction plane
-/// and the objects on it with their PCA boxes), motions (the hand path, its motion features, the
+/// and the objects on it with their PCA boxes, completed over time by the blob map), motions (the hand path, its motion features, the
 /// transports, independent object motions) and locations (the location areas) — plus the action
 /// label linked to the object functions of the Atlas that explain it.
 #include <string>
@@ -13,6 +13,7 @@
 #include "romo/indoor_manip/action_label.hpp"
 #include "romo/indoor_manip/interaction_plane.hpp"
 #include "romo/indoor_manip/location_areas.hpp"
+#include "romo/indoor_manip/object_map.hpp"
 #include "romo/indoor_manip/object_functions.hpp"
 #include "romo/indoor_manip/scene_objects.hpp"
 
@@ -25,6 +26,10 @@ struct KnowledgeContainer {
     InteractionPlane plane;
     int plane_inliers = 0;
     std::vector<SceneObject> objects;
+    /// The blob map's objects over all frames: an object of the first frame carries the one it
+    /// started (CompletedObject::first_frame_object), the others are listed as later objects.
+    std::vector<CompletedObject> completed;
+    ObjectMapStats map;
   } physics;
   struct Motions {
     int frames = 0;

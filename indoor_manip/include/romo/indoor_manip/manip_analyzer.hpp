@@ -15,6 +15,7 @@
 #include "romo/indoor_manip/hand_segmentation.hpp"
 #include "romo/indoor_manip/interaction_plane.hpp"
 #include "romo/indoor_manip/location_areas.hpp"
+#include "romo/indoor_manip/object_map.hpp"
 #include "romo/indoor_manip/rgbd_image.hpp"
 #include "romo/indoor_manip/scene_objects.hpp"
 
@@ -32,6 +33,11 @@ struct ManipParams {
   bool object_motions = true;
   OdometryParams odometry;
   mapping::IcpParams icp;
+  /// The blob map over the frames (object completion with confidence values, Sec. 3.4): the
+  /// objects of every object_map.every_frames-th frame with a hand, placed by the ego-motion
+  /// (odometry); off: no completed objects.
+  bool object_map = true;
+  ObjectMapParams map;
   Encapsulation encapsulation = Encapsulation::kPln;
   /// Frames after which a lost hand ends tracking (the path keeps the predictions until then).
   int max_lost_frames = 15;
@@ -60,6 +66,9 @@ struct ManipResult {
   SceneGeometry scene;
   /// Independent motions of the first frame's objects by the last frame.
   std::vector<ObjectMotion> object_motions;
+  /// The blob map's objects (world frame = the first frame's camera), first-frame ones first.
+  std::vector<CompletedObject> completed_objects;
+  ObjectMapStats object_map;
   InteractionPlane plane;
   int frames = 0;
   int frames_without_hand = 0;

@@ -71,7 +71,10 @@ struct BlobMapParams {
 struct BlobMapUpdate {
   int intersections = 0;
   int matched = 0;
-  int unpredicted = 0;
+  int unpredicted = 0;  ///< observations added as new points
+  /// Unmatched observations within the gate of a stored point of the same blob that matched a
+  /// neighbouring observation: not added (no duplicate surface points).
+  int redundant = 0;
   int unobserved = 0;
   int new_blobs = 0;
   /// Per stored blob updated: the rigid correction of eq. 3.11 applied to all its points.
