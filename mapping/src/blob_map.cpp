@@ -22,8 +22,51 @@ Aabb Aabb::Of(const Eigen::Matrix3Xd& xyz, double margin_m) {
   return b;
 }
 
-std::vector<std::pair<int, int>> IntersectBlobs(const std::vector<Aabb>& stored,
-                                                const std::vector<Aabb>& fresh) {
+Obb Obb::Of(const Eigen::Matrix3Xd& xyz, double margin_m) {
+  Obb b;
+  if (xyz.cols() == 0) {
+    b.half_m.setConstant(margin_m);
+    return b;
+  }
+  const Eigen::Vector3d mean = xyz.rowwise().mean();
+  const Eigen::Matrix3Xd c = xyz.colwise() - mean;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(c * c.transpose());
+  b.axes = es.eigenvectors();  // orthonormal columns
+  const Eigen::Matrix3Xd local = b.axes.transpose() * c;
+  const Eigen::Vector3d lo = local.rowwise().minCoeff(), hi = local.rowwise().maxCoeff();
+  b.center = mean + b.axes * (0.5 * (lo + hi));
+  b.half_m = (0.5 * (hi - lo)).array() + margin_m;
+  return b;
+}
+
+bool Obb::Intersects(const Obb& o) const {
+  // Gottschalk's OBBTree test: B's axes in A's frame, R(i, j) = a_i . b_j.
+  const Eigen::Matrix3d R = axes.transpose() * o.axes;
+  // Parallel edges make the cross products near zero: a small epsilon keeps the test robust.
+  const Eigen::Matrix3d absR = R.cwiseAbs().array() + 1e-12;
+  const Eigen::Vector3d t = axes.transpose() * (o.center - center);
+  const Eigen::Vector3d& a = half_m;
+  const Eigen::Vector3d& b = o.half_m;
+  for (int i = 0; i < 3; ++i) {  // A's face normals
+    if (std::abs(t[i]) > a[i] + b.dot(absR.row(i))) return false;
+  }
+  for (int j = 0; j < 3; ++j) {  // B's face normals
+    if (std::abs(t.dot(R.col(j))) > a.dot(absR.col(j)) + b[j]) return false;
+  }
+  for (int i = 0; i < 3; ++i) {  // a_i x b_j
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; ++j) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      const double ra = a[i1] * absR(i2, j) + a[i2] * absR(i1, j);
+      const double rb = b[j1] * absR(i, j2) + b[j2] * absR(i, j1);
+      if (std::abs(t[i2] * R(i1, j) - t[i1] * R(i2, j)) > ra + rb) return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::pair<int, int>> IntersectBlobs(const std::vector<Obb>& stored,
+                                                const std::vector<Obb>& fresh) {
   std::vector<std::pair<int, int>> out;
   for (int j = 0; j < static_cast<int>(stored.size()); ++j) {
     for (int i = 0; i < static_cast<int>(fresh.size()); ++i) {
@@ -100,9 +143,9 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
   const Eigen::Isometry3d T_cam_world = cam.T_world_camera.inverse();
 
   // Alg. 1 intersection search.
-  std::vector<Aabb> stored_boxes, fresh_boxes;
-  for (const auto& b : blobs_) stored_boxes.push_back(Aabb::Of(b.xyz_world, params_.box_margin_m));
-  for (const auto& b : fresh) fresh_boxes.push_back(Aabb::Of(b.xyz_world, params_.box_margin_m));
+  std::vector<Obb> stored_boxes, fresh_boxes;
+  for (const auto& b : blobs_) stored_boxes.push_back(Obb::Of(b.xyz_world, params_.box_margin_m));
+  for (const auto& b : fresh) fresh_boxes.push_back(Obb::Of(b.xyz_world, params_.box_margin_m));
   const auto pairs = IntersectBlobs(stored_boxes, fresh_boxes);
   out.intersections = static_cast<int>(pairs.size());
 

@@ -15,8 +15,7 @@
 
 namespace romo::mapping {
 
-/// Axis-aligned box in the world frame: the collision volume of Alg. 1 (conservative for
-/// rotated objects).
+/// Axis-aligned box in the world frame (kept for comparison: conservative for rotated objects).
 struct Aabb {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d hi = Eigen::Vector3d::Constant(-1e300);
@@ -26,9 +25,22 @@ struct Aabb {
   }
 };
 
-/// Alg. 1: pairs (stored index, new index) whose boxes collide.
-std::vector<std::pair<int, int>> IntersectBlobs(const std::vector<Aabb>& stored,
-                                                const std::vector<Aabb>& fresh);
+/// Oriented box (rectangular solid) in the world frame: the collision volume of Alg. 1.
+struct Obb {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< columns: unit box axes
+  Eigen::Vector3d half_m = Eigen::Vector3d::Zero();    ///< half extents along the axes
+  /// The box along the points' principal axes, grown by @p margin_m on every side; empty input
+  /// gives a box of half size @p margin_m at the origin.
+  static Obb Of(const Eigen::Matrix3Xd& xyz, double margin_m);
+  /// Separating-axis test over the 15 candidate axes of two boxes (3 + 3 face normals, 9 edge
+  /// cross products); touching counts as intersecting.
+  bool Intersects(const Obb& o) const;
+};
+
+/// Alg. 1: pairs (stored index, new index) whose oriented boxes collide.
+std::vector<std::pair<int, int>> IntersectBlobs(const std::vector<Obb>& stored,
+                                                const std::vector<Obb>& fresh);
 
 struct PinholeCamera {
   double fx_px = 0, fy_px = 0, cx_px = 0, cy_px = 0;
@@ -61,7 +73,7 @@ struct BlobMapParams {
   int search_radius_px = 2;
   /// A stored point is occluded when the current depth at its pixel is this much closer (m).
   double occlusion_margin_m = 0.03;
-  /// Box margin for the intersection search (m).
+  /// Margin of the oriented boxes of the intersection search (m).
   double box_margin_m = 0.02;
   ConfidenceParams confidence;
   EgoMotionParams rigid;  ///< RANSAC of the rigid check (3.11)
