@@ -104,7 +104,8 @@ struct SeqCase {
   DepthIntrinsics k;
 };
 
-// Checks every consecutive pair whose true rotation is below max_step_deg with the given features.
+// Checks every consecutive pair whose true rotation is below max_step_deg with the given features;
+// the larger steps are estimated and their errors printed, not checked.
 void CheckSequence(const SeqCase& c, double max_t_m, double max_r_deg,
                    const std::vector<FeatureKind>& kinds, double max_step_deg = 180.0) {
   ASSERT_GE(c.poses.size(), c.frames.size());
@@ -113,16 +114,23 @@ void CheckSequence(const SeqCase& c, double max_t_m, double max_r_deg,
     params.features = kind;
     double worst_t = 0.0, worst_r = 0.0;
     for (std::size_t i = 0; i + 1 < c.frames.size(); ++i) {
-      const auto motion = EstimateEgoMotion(c.frames[i], c.frames[i + 1], c.k, params);
-      ASSERT_TRUE(motion.has_value()) << c.name << " " << i;
       const Eigen::Isometry3d truth = c.poses[i + 1].inverse() * c.poses[i];
-      if (Eigen::AngleAxisd(truth.linear()).angle() * 180 / M_PI > max_step_deg) continue;
+      const double step_deg = Eigen::AngleAxisd(truth.linear()).angle() * 180 / M_PI;
+      const bool checked = step_deg <= max_step_deg;
+      const auto motion = EstimateEgoMotion(c.frames[i], c.frames[i + 1], c.k, params);
+      if (!motion) {
+        std::printf("%s %d->%d feature %d: true step %.3f m %.2f deg, no motion found%s\n", c.name, int(i),
+                    int(i + 1), int(kind), truth.translation().norm(), step_deg, checked ? "" : " (not checked)");
+        EXPECT_FALSE(checked) << c.name << " " << i << " feature " << int(kind) << ": no motion";
+        continue;
+      }
       const MotionError e = Compare(motion->T_2_1, truth);
       std::printf("%s %d->%d feature %d: inliers %zu outliers %zu, true step %.3f m %.2f deg, "
-                  "error %.4f m %.3f deg\n",
+                  "error %.4f m %.3f deg%s\n",
                   c.name, int(i), int(i + 1), int(kind), motion->inliers.size(), motion->outliers.size(),
-                  truth.translation().norm(), Eigen::AngleAxisd(truth.linear()).angle() * 180 / M_PI,
-                  e.translation_m, e.rotation_deg);
+                  truth.translation().norm(), step_deg, e.translation_m, e.rotation_deg,
+                  checked ? "" : " (not checked)");
+      if (!checked) continue;
       worst_t = std::max(worst_t, e.translation_m);
       worst_r = std::max(worst_r, e.rotation_deg);
     }
@@ -140,15 +148,21 @@ TEST(RgbdSceneTest, EgoMotionMatchesKinectSeqPoses) {
                                 test::SharedData("rgbd/kinect_seq/depth/" + std::to_string(i) + ".pgm"),
                                 0.001));
   }
-  // Tolerances from what the runs achieve (printed above). These frames are far apart (0.23-0.73 m
-  // and up to 25 deg per step), so only 12-200 features match, and the depth maps are not
-  // registered to the colour images (features lift with a few-pixel offset at depth edges).
-  // Measured with AKAZE on the pairs below 10 deg: <= 0.27 m, <= 1.9 deg; ORB and SIFT are worse
-  // (up to 0.87 m, 7 deg) and the 25-deg pair fails for all. Bounds are set just above AKAZE's.
-  constexpr double kMaxTranslationErrM = 0.3;
-  constexpr double kMaxRotationErrDeg = 2.5;
+  // Tolerances from what the runs achieve (printed above), per feature kind. These frames are far
+  // apart (0.23-0.73 m and up to 25 deg per step), so only 12-200 features match, and the depth
+  // maps are not registered to the colour images (features lift with a few-pixel offset at depth
+  // edges). The three pairs below 10 deg are checked; the 25-deg pair 0->1 is estimated and
+  // printed (measured: AKAZE 0.66 m / 2.6 deg, ORB 0.65 m / 4.1 deg, SIFT 0.76 m / 4.1 deg,
+  // no usable motion from 12-32 inliers) but not checked.
   constexpr double kMaxStepDeg = 10.0;
-  CheckSequence(c, kMaxTranslationErrM, kMaxRotationErrDeg, {FeatureKind::kAkaze}, kMaxStepDeg);
+  // AKAZE (nonlinear scale space, the most repeatable here): measured <= 0.264 m, <= 1.84 deg.
+  CheckSequence(c, 0.3, 2.5, {FeatureKind::kAkaze}, kMaxStepDeg);
+  // SIFT: fewer inliers on 1->2 (33 of 141): measured <= 0.343 m, <= 2.98 deg.
+  CheckSequence(c, 0.4, 3.5, {FeatureKind::kSift}, kMaxStepDeg);
+  // ORB (FAST corners, binary descriptors; the blur and viewpoint change between these frames
+  // defeat it most): measured <= 0.871 m, <= 7.22 deg on 2->3, an error as large as the step, so
+  // this bound only guards against a collapse (no motion, or a wildly wrong one).
+  CheckSequence(c, 1.0, 8.5, {FeatureKind::kOrb}, kMaxStepDeg);
 }
 
 TEST(RgbdSceneTest, EgoMotionMatchesPrimesenseSeqTrajectory) {
