@@ -108,13 +108,16 @@ void RunManip(const ManipArgs& a) {
   opt.max_frames = a.max_frames;
   auto source = drivers::OpenSource(a.source);
   indoor_manip::DepthIntrinsics k;
+  std::string k_origin = "--intrinsics";
   if (!a.intrinsics.empty()) {
     k = indoor_manip::DepthIntrinsics::Parse(a.intrinsics, "--intrinsics");
   } else if (auto from_source = indoor_manip::IntrinsicsFromSource(*source)) {
     k = *from_source;
+    k_origin = "the source's calibration";
   } else {
     Fail("source '" + a.source + "' carries no calibration: give --intrinsics fx,fy,cx,cy");
   }
+  std::printf("intrinsics fx %g fy %g cx %g cy %g from %s\n", k.fx_px, k.fy_px, k.cx_px, k.cy_px, k_origin.c_str());
   std::filesystem::create_directories(a.out);
   Progress progress("manip", static_cast<std::uint64_t>(std::max(0, a.max_frames)));
   opt.on_frame = [&](int done) { progress.Update(static_cast<std::uint64_t>(done)); };

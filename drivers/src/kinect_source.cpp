@@ -12,6 +12,7 @@
 #include <libfreenect_sync.h>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frame_source.hpp"
 
 namespace romo::drivers {
@@ -20,6 +21,32 @@ namespace {
 constexpr int kWidth = 640;   // FREENECT_RESOLUTION_MEDIUM, the only mode fakenect replays
 constexpr int kHeight = 480;
 constexpr int kInvalidRaw = 2047;  // 11-bit depth: no return
+
+// Default Kinect v1 intrinsics at 640x480: fx = fy = 525, cx = 319.5, cy = 239.5 px, the values
+// ROS's openni/freenect camera drivers publish for an uncalibrated Kinect and that the TUM RGB-D
+// benchmark lists as the "ROS default" (vision.in.tum.de/data/datasets/rgbd-dataset/file_formats).
+// They describe the RGB camera; the unregistered depth camera is within a few per cent (TUM's own
+// calibrations: fx 517-591). romo manip --intrinsics overrides them with a calibrated K.
+constexpr double kDefaultFocalPx = 525.0;
+constexpr double kDefaultCxPx = 319.5;
+constexpr double kDefaultCyPx = 239.5;
+constexpr double kIrToRgbBaselineM = 0.025;  // Kinect v1 / PrimeSense: IR and RGB cameras
+
+Calibration DefaultKinectCalibration(int index) {
+  RigCalibration rig;
+  rig.rig_id = 0;
+  rig.name = "kinect" + std::to_string(index);
+  rig.width_px = kWidth;
+  rig.height_px = kHeight;
+  rig.left.K << kDefaultFocalPx, 0, kDefaultCxPx, 0, kDefaultFocalPx, kDefaultCyPx, 0, 0, 1;
+  // Right = the RGB camera beside the depth (IR) camera, 2.5 cm apart on a Kinect v1; romo reads
+  // only the left K (depth), the baseline makes it a valid rig for recordings.
+  rig.right.K = rig.left.K;
+  rig.T << -kIrToRgbBaselineM, 0, 0;
+  Calibration c;
+  c.rigs.push_back(rig);
+  return c;
+}
 
 // Raw 11-bit Kinect disparity to millimetres (the OpenKinect community's tangent fit,
 // depth_m = 0.1236 * tan(raw / 2842.5 + 1.1863)); 0 where the sensor saw nothing or the fit
@@ -39,7 +66,7 @@ const std::array<std::uint16_t, 2048>& RawToMillimetres() {
 
 class KinectSource : public FrameSource {
  public:
-  explicit KinectSource(int index) : index_(index) {
+  explicit KinectSource(int index) : index_(index), calibration_(DefaultKinectCalibration(index)) {
     counters_.camera_id = "kinect:" + std::to_string(index);
   }
   ~KinectSource() override { freenect_sync_stop(); }
@@ -87,8 +114,12 @@ class KinectSource : public FrameSource {
     return status;
   }
 
+  /// The Kinect v1 defaults (see kDefaultFocalPx): libfreenect reads no calibration.
+  const Calibration* calibration() const override { return &calibration_; }
+
  private:
   int index_;
+  Calibration calibration_;
   CameraCounters counters_;
   std::vector<std::string> events_;
 };

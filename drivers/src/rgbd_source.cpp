@@ -6,12 +6,18 @@
 //   flat pairs     <stem>.png with <stem>_depth.png (TUM samples); depth value / 5000 = metres
 // Options: ?depth_scale=<units per metre>, ?max_dt_s= (TUM pairing tolerance),
 // ?rate_hz= (stamps for layouts without timestamps).
+// Intrinsics: a camera JSON in the folder (camera*.json or intrinsic*.json, Open3D's
+// PinholeCameraIntrinsic layout {"width", "height", "intrinsic_matrix": 9 numbers column-major},
+// as primesense_seq's camera_primesense.json) becomes the source's calibration (one rig, left =
+// right = that K); the first in name order when there are several.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <dirent.h>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <sys/stat.h>
@@ -20,6 +26,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frame_source.hpp"
 
 namespace romo::drivers {
@@ -112,11 +119,102 @@ std::vector<std::pair<double, std::string>> ReadStampList(const std::string& pat
   return entries;
 }
 
+// The number after "key": in @p text; @throws romo::Error naming @p path when it is missing.
+double JsonNumberAfter(const std::string& text, std::size_t at, const std::string& path, const std::string& key) {
+  while (at < text.size() && (std::isspace(static_cast<unsigned char>(text[at])) || text[at] == ':')) ++at;
+  char* end = nullptr;
+  const double v = at < text.size() ? std::strtod(text.c_str() + at, &end) : 0.0;
+  if (at >= text.size() || end == text.c_str() + at || !std::isfinite(v)) {
+    Fail(path + ": \"" + key + "\" must be followed by a number");
+  }
+  return v;
+}
+
+std::size_t JsonKey(const std::string& text, const std::string& path, const std::string& key) {
+  const std::size_t at = text.find("\"" + key + "\"");
+  if (at == std::string::npos) Fail(path + ": camera JSON without \"" + key + "\"");
+  return at + key.size() + 2;
+}
+
+// Open3D PinholeCameraIntrinsic JSON -> one rig with that K (left and right).
+RigCalibration ReadCameraJson(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Fail(path + ": cannot open camera JSON");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  constexpr std::size_t kMaxBytes = 64 * 1024;
+  if (text.size() > kMaxBytes) Fail(path + ": camera JSON larger than 64 KiB");
+  const double width = JsonNumberAfter(text, JsonKey(text, path, "width"), path, "width");
+  const double height = JsonNumberAfter(text, JsonKey(text, path, "height"), path, "height");
+  std::size_t at = JsonKey(text, path, "intrinsic_matrix");
+  at = text.find('[', at);
+  const std::size_t close = at == std::string::npos ? at : text.find(']', at);
+  if (close == std::string::npos) Fail(path + ": \"intrinsic_matrix\" must be an array of 9 numbers");
+  std::vector<double> m;
+  for (std::size_t p = at + 1; p < close;) {
+    while (p < close && (std::isspace(static_cast<unsigned char>(text[p])) || text[p] == ',')) ++p;
+    if (p >= close) break;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str() + p, &end);
+    if (end == text.c_str() + p || !std::isfinite(v)) {
+      Fail(path + ": \"intrinsic_matrix\" holds a non-number at byte " + std::to_string(p));
+    }
+    m.push_back(v);
+    p = static_cast<std::size_t>(end - text.c_str());
+  }
+  if (m.size() != 9) {
+    Fail(path + ": \"intrinsic_matrix\" must hold 9 numbers (column-major 3x3), got " + std::to_string(m.size()));
+  }
+  // Column-major: fx 0 0, 0 fy 0, cx cy 1.
+  const double fx = m[0], fy = m[4], cx = m[6], cy = m[7];
+  if (!(width >= 1 && height >= 1 && width <= 65536 && height <= 65536) || width != std::floor(width) ||
+      height != std::floor(height)) {
+    Fail(path + ": width x height " + std::to_string(width) + " x " + std::to_string(height) + " is not an image size");
+  }
+  if (!(fx > 0 && fy > 0) || m[1] != 0 || m[2] != 0 || m[3] != 0 || m[5] != 0 || m[8] != 1 ||
+      !(cx >= 0 && cx <= width && cy >= 0 && cy <= height)) {
+    Fail(path + ": \"intrinsic_matrix\" is not a pinhole K (column-major fx 0 0 0 fy 0 cx cy 1 with fx, fy > 0 "
+         "and the centre in the image), got fx=" + std::to_string(fx) + " fy=" + std::to_string(fy) +
+         " cx=" + std::to_string(cx) + " cy=" + std::to_string(cy));
+  }
+  RigCalibration rig;
+  rig.rig_id = 0;
+  rig.name = "rgbd";
+  rig.width_px = static_cast<int>(width);
+  rig.height_px = static_cast<int>(height);
+  rig.left.K << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+  // Right = the RGB camera, 2.5 cm beside the depth camera on Kinect-class sensors (nominal: the
+  // folder's depth may be registered to colour already); only the left K is read, the baseline
+  // makes it a valid rig for recordings.
+  rig.right.K = rig.left.K;
+  rig.T << -0.025, 0, 0;
+  return rig;
+}
+
+// camera*.json / intrinsic*.json in @p folder, name order.
+std::vector<std::string> CameraJsonFiles(const std::string& folder) {
+  std::vector<std::string> out;
+  for (const auto& name : ListFiles(folder)) {
+    const bool json = name.size() > 5 && name.compare(name.size() - 5, 5, ".json") == 0;
+    if (json && (name.rfind("camera", 0) == 0 || name.rfind("intrinsic", 0) == 0)) out.push_back(name);
+  }
+  return out;
+}
+
 class RgbdFolderSource : public FrameSource {
  public:
   RgbdFolderSource(std::string folder, std::vector<Pair> pairs, double units_per_m,
                    std::uint64_t unpaired, std::string layout)
       : folder_(std::move(folder)), pairs_(std::move(pairs)), units_per_m_(units_per_m) {
+    const auto cameras = CameraJsonFiles(folder_);
+    if (!cameras.empty()) {
+      camera_json_ = folder_ + "/" + cameras.front();
+      calibration_.rigs.push_back(ReadCameraJson(camera_json_));
+      const auto& K = calibration_.rigs.front().left.K;
+      status_events_.push_back(folder_ + ": intrinsics from " + cameras.front() + " (fx " + std::to_string(K(0, 0)) +
+                               ", fy " + std::to_string(K(1, 1)) + ", cx " + std::to_string(K(0, 2)) + ", cy " +
+                               std::to_string(K(1, 2)) + ")" +
+                               (cameras.size() > 1 ? ", the first of " + std::to_string(cameras.size()) : ""));
+    }
     counters_.camera_id = "rgbd:" + folder_;
     counters_.unpaired = unpaired;
     status_events_.push_back(folder_ + ": " + layout + " layout, " + std::to_string(pairs_.size()) +
@@ -137,6 +235,14 @@ class RgbdFolderSource : public FrameSource {
     RgbdFrame frame;
     frame.rgb = LoadRgb(pair.rgb);
     frame.depth = LoadDepth(pair.depth);
+    if (!calibration_.rigs.empty()) {
+      const RigCalibration& rig = calibration_.rigs.front();
+      if (frame.depth.width != rig.width_px || frame.depth.height != rig.height_px) {
+        Fail(pair.depth + ": " + std::to_string(frame.depth.width) + "x" + std::to_string(frame.depth.height) +
+             " depth image, but " + camera_json_ + " is for " + std::to_string(rig.width_px) + "x" +
+             std::to_string(rig.height_px));
+      }
+    }
     frame.depth_scale_m = 1.0 / units_per_m_;
     frame.stamp_ns = pair.stamp_ns;
     frame.sequence = next_;
@@ -151,6 +257,10 @@ class RgbdFolderSource : public FrameSource {
     status.cameras.push_back(counters_);
     status.events = status_events_;
     return status;
+  }
+
+  const Calibration* calibration() const override {
+    return calibration_.rigs.empty() ? nullptr : &calibration_;
   }
 
  private:
@@ -187,6 +297,8 @@ class RgbdFolderSource : public FrameSource {
   std::string folder_;
   std::vector<Pair> pairs_;
   double units_per_m_;
+  std::string camera_json_;
+  Calibration calibration_;
   std::size_t next_ = 0;
   CameraCounters counters_;
   std::vector<std::string> status_events_;

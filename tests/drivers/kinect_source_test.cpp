@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frame_source.hpp"
 #include "romo/drivers/recording.hpp"
 #include "test_support.hpp"
@@ -95,6 +96,17 @@ TEST(KinectSourceTest, FakenectReplayRecordsThroughTheSameCode) {
     ++count;
   }
   EXPECT_EQ(count, 3);
+  // libfreenect reads no calibration: the recording carries the Kinect v1 defaults (640x480,
+  // fx = fy = 525, c = (319.5, 239.5)), so romo manip needs no --intrinsics.
+  const Calibration* calib = reader.calibration();
+  ASSERT_NE(calib, nullptr);
+  ASSERT_EQ(calib->rigs.size(), 1u);
+  const Eigen::Matrix3d& K = calib->rigs.front().left.K;
+  EXPECT_EQ(K(0, 0), 525.0);
+  EXPECT_EQ(K(1, 1), 525.0);
+  EXPECT_EQ(K(0, 2), 319.5);
+  EXPECT_EQ(K(1, 2), 239.5);
+  EXPECT_EQ(calib->rigs.front().width_px, 640);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frame_source.hpp"
 #include "test_support.hpp"
 
@@ -116,6 +117,55 @@ TEST(RgbdSourceTest, TumTextFilesPairByNearestTimestampWithinTolerance) {
   test::WriteFile(dir / "associations.txt", "1.000 rgb/a.png 1.005 depth/a.png\n1.066 rgb/c.png 1.2 depth/c.png\n");
   auto assoc = OpenSource("rgbd://" + dir.path());
   EXPECT_EQ(ReadAll(assoc.get()).size(), 2u);
+}
+
+TEST(RgbdSourceTest, CameraJsonInTheFolderGivesTheIntrinsics) {
+  ROMO_REQUIRE_SHARED_DATA("rgbd/primesense_seq");
+  ROMO_REQUIRE_SHARED_DATA("rgbd/kinect_seq");
+  // primesense_seq/camera_primesense.json: Open3D's layout, K column-major.
+  auto source = OpenSource("rgbd://" + test::SharedData("rgbd/primesense_seq"));
+  const Calibration* calib = source->calibration();
+  ASSERT_NE(calib, nullptr);
+  ASSERT_EQ(calib->rigs.size(), 1u);
+  const RigCalibration& rig = calib->rigs.front();
+  EXPECT_EQ(rig.width_px, 640);
+  EXPECT_EQ(rig.height_px, 480);
+  EXPECT_EQ(rig.left.K(0, 0), 525.0);
+  EXPECT_EQ(rig.left.K(1, 1), 525.0);
+  EXPECT_EQ(rig.left.K(0, 2), 319.5);
+  EXPECT_EQ(rig.left.K(1, 2), 239.5);
+  EXPECT_NO_THROW(calib->Validate("primesense_seq"));  // recordings carry it
+  bool reported = false;
+  for (const auto& e : source->status().events) reported |= e.find("camera_primesense.json") != std::string::npos;
+  EXPECT_TRUE(reported);
+  EXPECT_EQ(ReadAll(source.get()).size(), 5u);
+  // A folder without one carries no calibration.
+  EXPECT_EQ(OpenSource("rgbd://" + test::SharedData("rgbd/kinect_seq"))->calibration(), nullptr);
+}
+
+TEST(RgbdSourceTest, BadCameraJsonGivesClearErrors) {
+  ROMO_REQUIRE_SHARED_DATA("rgbd/tum_pair");
+  const std::string data = test::SharedData("rgbd/tum_pair");
+  test::ScratchDir dir;
+  for (const char* name : {"1.png", "1_depth.png"}) {
+    ASSERT_EQ(::symlink((data + "/" + name).c_str(), (dir / name).c_str()), 0);
+  }
+  const std::string uri = "rgbd://" + dir.path();
+  test::WriteFile(dir / "camera.json", R"({"width": 640, "height": 480, "intrinsic_matrix": [520, 0, 0, 0, 521, 0, 325]})");
+  std::string e = ErrorOf([&] { OpenSource(uri); });
+  EXPECT_NE(e.find("camera.json: \"intrinsic_matrix\" must hold 9 numbers (column-major 3x3), got 7"),
+            std::string::npos) << e;
+  test::WriteFile(dir / "camera.json", R"({"height": 480, "intrinsic_matrix": [520, 0, 0, 0, 521, 0, 325, 249, 1]})");
+  e = ErrorOf([&] { OpenSource(uri); });
+  EXPECT_NE(e.find("camera JSON without \"width\""), std::string::npos) << e;
+  test::WriteFile(dir / "camera.json", R"({"width": 640, "height": 480, "intrinsic_matrix": [-520, 0, 0, 0, 521, 0, 325, 249, 1]})");
+  e = ErrorOf([&] { OpenSource(uri); });
+  EXPECT_NE(e.find("is not a pinhole K"), std::string::npos) << e;
+  // Valid, but for other images than the folder's 640x480 ones: the first frame says so.
+  test::WriteFile(dir / "camera.json", R"({"width": 320, "height": 240, "intrinsic_matrix": [260, 0, 0, 0, 260, 0, 160, 120, 1]})");
+  auto source = OpenSource(uri);
+  e = ErrorOf([&] { source->Next(); });
+  EXPECT_NE(e.find("640x480 depth image, but " + (dir / "camera.json") + " is for 320x240"), std::string::npos) << e;
 }
 
 TEST(RgbdSourceTest, BadFoldersAndFilesGiveClearErrors) {

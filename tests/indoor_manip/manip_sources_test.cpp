@@ -67,11 +67,20 @@ void CheckOutputs(const std::string& dir, Eigen::Vector3d* normal, int* plane_in
 TEST(ManipSourcesTest, PrimesenseSequenceWithPickedFloorPlane) {
   ROMO_REQUIRE_SHARED_DATA("rgbd/primesense_seq");
   test::ScratchDir dir;
-  // Three floor pixels pick the plane; the chair seat's front edge plays the hand.
+  // Three floor pixels pick the plane; the chair seat's front edge plays the hand. No
+  // --intrinsics: the folder's camera_primesense.json gives them.
   const auto r = test::RunRomo("manip --source rgbd://" + test::SharedData("rgbd/primesense_seq") +
-                               " --intrinsics 525,525,319.5,239.5 --plane 100,440,560,450,300,390"
-                               " --hand-seed 500,262 --out " + dir.path());
+                               " --plane 100,440,560,450,300,390 --hand-seed 500,262 --out " + dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("intrinsics fx 525 fy 525 cx 319.5 cy 239.5 from the source's calibration"),
+            std::string::npos) << r.out;
+  // --intrinsics still overrides the folder's.
+  test::ScratchDir other;
+  const auto o = test::RunRomo("manip --source rgbd://" + test::SharedData("rgbd/primesense_seq") +
+                               " --intrinsics 530,530,320,240 --plane 100,440,560,450,300,390 --hand-seed 500,262"
+                               " --max-frames 2 --out " + other.path());
+  ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+  EXPECT_NE(o.out.find("intrinsics fx 530 fy 530 cx 320 cy 240 from --intrinsics"), std::string::npos) << o.out;
   Eigen::Vector3d n;
   int inliers = 0, objects = 0;
   CheckOutputs(dir.path(), &n, &inliers, &objects);
@@ -125,11 +134,14 @@ TEST(ManipSourcesTest, FakenectDumpThroughKinectSource) {
   test::WriteFile(dir / "INDEX.txt", index);
   const auto& truth = scene.truth();
   const auto r = test::RunShell("timeout 300 fakenect '" + dir.path() + "' '" + test::RomoBinary() +
-                                "' manip --source kinect://0 --intrinsics 525,525,319.5,239.5 --plane auto"
+                                "' manip --source kinect://0 --plane auto"
                                 " --hand-seed " + std::to_string(truth.seed_u_px) + "," +
                                 std::to_string(truth.seed_v_px) + " --max-frames " + std::to_string(kFrames) +
                                 " --out '" + (dir / "out") + "'");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  // No --intrinsics: kinect:// carries the Kinect v1 defaults (the scene is rendered with them).
+  EXPECT_NE(r.out.find("intrinsics fx 525 fy 525 cx 319.5 cy 239.5 from the source's calibration"),
+            std::string::npos) << r.out;
   Eigen::Vector3d n;
   int inliers = 0, objects = 0;
   CheckOutputs(dir / "out", &n, &inliers, &objects);
