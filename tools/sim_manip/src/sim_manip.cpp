@@ -40,6 +40,22 @@ double ValueNoise(double x, double y, double cell, std::uint64_t salt) {
   return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
 }
 
+// The sliding book of slide=1 (plane frame): 20 x 14 x 4 cm, front left of the hand's start, at
+// rest for the first third, pushed 10 cm right, 4 cm back and turned 15 deg about the plane
+// normal (eased) in the middle third, at rest again for the last.
+const Eigen::Vector3d kBookHalf(0.10, 0.07, 0.02);  // half extents; it stands on z = 0
+const Eigen::Vector2d kBookStart(-0.25, -0.18);
+const Eigen::Vector2d kBookShift(0.10, 0.04);
+constexpr double kBookTurnRad = 15.0 * M_PI / 180.0;
+
+// Centre (plane frame, on the plane) and yaw of the book at frame @p k of @p frames.
+std::pair<Eigen::Vector3d, double> BookPose(int k, int frames) {
+  const double s = std::clamp((3.0 * k / std::max(1, frames - 1)) - 1.0, 0.0, 1.0);
+  const double e = s * s * (3 - 2 * s);
+  const Eigen::Vector2d c = kBookStart + e * kBookShift;
+  return {Eigen::Vector3d(c.x(), c.y(), kBookHalf.z()), e * kBookTurnRad};
+}
+
 // Axial noise of a Kinect v1 (Nguyen, Izadi, Lovell 2012): 1.2 mm + 1.9 mm * (z - 0.4 m)^2.
 double KinectSigmaM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
 
@@ -56,9 +72,9 @@ SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
   o.action = uri.path;
   for (const auto& [key, value] : uri.query) {
     if (key != "seed" && key != "frames" && key != "width" && key != "height" && key != "fps" &&
-        key != "noise" && key != "transports" && key != "prop") {
+        key != "noise" && key != "transports" && key != "prop" && key != "slide") {
       Fail("sim-manip URI '" + uri.ToString() + "': unknown query key '" + key +
-           "' (known: seed, frames, width, height, fps, noise, transports, prop)");
+           "' (known: seed, frames, width, height, fps, noise, transports, prop, slide)");
     }
   }
   if (auto v = uri.GetInt("seed")) {
@@ -72,6 +88,7 @@ SimManipOptions SimManipOptions::FromUri(const drivers::Uri& uri) {
   if (auto v = uri.GetInt("noise")) o.noise = *v != 0;
   if (auto v = uri.GetInt32("transports")) o.transports = *v;
   if (auto v = uri.GetInt("prop")) o.prop = *v != 0;
+  if (auto v = uri.GetInt("slide")) o.slide = *v != 0;
   o.Validate();
   return o;
 }
@@ -89,6 +106,9 @@ void SimManipOptions::Validate() const {
   if (!(fps >= 1.0 && fps <= 240.0)) Fail("sim-manip: fps must be in [1, 240], got " + std::to_string(fps));
   if (prop && internal::IsBoardAction(action)) {
     Fail("sim-manip: prop=1 needs a table action, got '" + action + "' (a whiteboard action)");
+  }
+  if (slide && internal::IsBoardAction(action)) {
+    Fail("sim-manip: slide=1 needs a table action, got '" + action + "' (a whiteboard action)");
   }
   if (transports < 0 || transports > 20) {
     Fail("sim-manip: transports must be in [0, 20], got " + std::to_string(transports));
@@ -211,6 +231,25 @@ class SimManipScene::Impl {
       t.axes_camera = R_C_P;
       truth_.objects.push_back(t);
     }
+    if (o.slide) {
+      // The book's local frame (centre, axes) into the camera at frame k: A_k; its motion since
+      // frame 0 is A_k A_0^-1.
+      auto local_to_camera = [&](int k) {
+        const auto [c, yaw] = BookPose(k, o.frames);
+        Eigen::Isometry3d A = Eigen::Isometry3d::Identity();
+        A.linear() = R_C_P * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        A.translation() = R_C_P * (c - eye_);
+        return A;
+      };
+      SimObjectTruth t;
+      t.name = "book";
+      t.size_m = 2 * kBookHalf;
+      const Eigen::Isometry3d A0 = local_to_camera(0);
+      t.centre_camera_m = A0.translation();
+      t.axes_camera = A0.linear();
+      for (int k = 0; k < o.frames; ++k) t.T_k_0_camera.push_back(local_to_camera(k) * A0.inverse());
+      truth_.objects.push_back(t);
+    }
     for (const auto& p : path_) {
       truth_.hand_centre_camera_m.push_back(R_C_P * (Eigen::Vector3d(p.u_m, p.v_m, p.h_m) - eye_));
       truth_.hand_yaw_rad.push_back(p.yaw_rad);
@@ -263,9 +302,15 @@ class SimManipScene::Impl {
           const double t = -eye_.z() / d.z();
           const Eigen::Vector3d p = eye_ + t * d;
           best = t;
-          const double tex = ValueNoise(p.x(), p.y(), 0.02, 11) * 0.6 + ValueNoise(p.x(), p.y(), 0.005, 12) * 0.4;
+          double tex = ValueNoise(p.x(), p.y(), 0.02, 11) * 0.6 + ValueNoise(p.x(), p.y(), 0.005, 12) * 0.4;
+          if (opt_.slide) {
+            // A patterned tablecloth (1 cm blocks): the still scene then holds most of the
+            // features, as a room does, and the ego-motion is the camera's, not the book's.
+            tex = 0.5 * tex + 0.5 * Hash(static_cast<std::int64_t>(std::floor(p.x() / 0.01)),
+                                         static_cast<std::int64_t>(std::floor(p.y() / 0.01)), 14);
+          }
           rgb = board_ ? Eigen::Vector3d(0.86, 0.87, 0.88) * (0.9 + 0.1 * tex)
-                       : Eigen::Vector3d(0.62, 0.45, 0.3) * (0.7 + 0.3 * tex);
+                       : Eigen::Vector3d(0.62, 0.45, 0.3) * (opt_.slide ? 0.35 + 0.65 * tex : 0.7 + 0.3 * tex);
         }
         for (const Box& b : boxes_) {
           double t0 = 0.0, t1 = kInf;
@@ -306,6 +351,48 @@ class SimManipScene::Impl {
     for (auto& n : noise_) n = gauss(rng);
   }
 
+  // The sliding book at frame @p k, ray-cast over the static background (its texture is fixed to
+  // the book, so features follow it).
+  void CastBook(int k, std::vector<double>* depth, std::vector<Eigen::Vector3f>* colour) const {
+    const int w = opt_.width_px, h = opt_.height_px;
+    const auto [c, yaw] = BookPose(k, opt_.frames);
+    const Eigen::Matrix3d R_local_P = Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d o = R_local_P * (eye_ - c);
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const Eigen::Vector3d d = R_local_P * Ray(u, v);
+        double t0 = 0.0, t1 = kInf;
+        int axis = -1;
+        bool hit = true;
+        for (int a = 0; a < 3 && hit; ++a) {
+          if (std::abs(d[a]) < 1e-12) {
+            hit = std::abs(o[a]) <= kBookHalf[a];
+            continue;
+          }
+          double ta = (-kBookHalf[a] - o[a]) / d[a], tb = (kBookHalf[a] - o[a]) / d[a];
+          if (ta > tb) std::swap(ta, tb);
+          if (ta > t0) {
+            t0 = ta;
+            axis = a;
+          }
+          t1 = std::min(t1, tb);
+          hit = t0 <= t1;
+        }
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        if (!hit || axis < 0 || ((*depth)[i] > 0 && t0 >= (*depth)[i])) continue;
+        const Eigen::Vector3d p = o + t0 * d;  // book frame
+        // A printed cover: random 8 mm blocks (corners for feature detectors) over fine noise.
+        const double qx = p.x() + p.z(), qy = p.y() - p.z();
+        const double block = Hash(static_cast<std::int64_t>(std::floor(qx / 0.008)),
+                                  static_cast<std::int64_t>(std::floor(qy / 0.008)), 31);
+        const double tex = 0.7 * block + 0.3 * ValueNoise(qx, qy, 0.004, 32);
+        const double shade = axis == 2 ? 1.0 : 0.75;
+        (*depth)[i] = t0;
+        (*colour)[i] = (Eigen::Vector3d(0.85, 0.35, 0.3) * shade * (0.15 + 0.85 * tex)).cast<float>();
+      }
+    }
+  }
+
   drivers::RgbdFrame Render(int k) const {
     ROMO_THROW_UNLESS(k >= 0 && k < opt_.frames);
     const int w = opt_.width_px, h = opt_.height_px;
@@ -319,6 +406,7 @@ class SimManipScene::Impl {
     const Eigen::Vector3d light = Eigen::Vector3d(0.3, -0.4, 1.0).normalized();
     std::vector<double> depth = bg_depth_;
     std::vector<Eigen::Vector3f> colour = bg_colour_;
+    if (opt_.slide) CastBook(k, &depth, &colour);
     // Only pixels inside the projection of the hand's bounding sphere can see the hand.
     const Eigen::Vector3d c_C = R_P_C_.transpose() * (hand_c - eye_);
     const double radius = kHandSemiAxes.maxCoeff();
