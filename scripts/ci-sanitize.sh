@@ -2,7 +2,7 @@
 # CI's second build: clang with AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g: Debug's
 # -O0 makes the simulator's renders too slow) and the libFuzzer targets, in one build directory.
 # Runs the unit tests in it (the whole suite with ROMO_ASAN_CTEST_ARGS=), then the fuzz smoke
-# (every target, 10 s) with the same binaries.
+# (every target, ROMO_FUZZ_RUNS inputs from seed 1) with the same binaries.
 # .ci/run calls it after ./scripts/test.sh.
 #
 #   ROMO_ASAN_BUILD_DIR   build directory (default build-asan-clang)

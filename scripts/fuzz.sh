@@ -2,7 +2,7 @@
 # Builds romo's libFuzzer targets (clang, AddressSanitizer + UndefinedBehaviorSanitizer, -O1 -g,
 # -DROMO_FUZZ=ON) and runs each for N seconds, printing executions and crashes per target.
 #
-#   scripts/fuzz.sh                      # CI smoke: every target, 10 s each
+#   scripts/fuzz.sh                      # every target, 10 s each
 #   scripts/fuzz.sh --seconds 600        # the longer run (10 min per target)
 #   scripts/fuzz.sh --seconds 60 pcd recording
 #   scripts/fuzz.sh --build-dir build-asan-clang --no-build   # reuse an existing fuzz build

@@ -1,11 +1,14 @@
 #include "romo/stereo/pcd_io.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
 
 #include "romo/core/check.hpp"
 #include "test_support.hpp"
@@ -84,6 +87,32 @@ TEST(PcdIoTest, ReadsPclTestFiles) {
   for (Eigen::Index i = 0; i < kinect.xyz.cols(); ++i) ASSERT_TRUE(kinect.xyz.col(i).allFinite());
 }
 
+TEST(PcdIoTest, SamePointsAsPclsOwnReaderOnEveryPclTestFile) {
+  // romo reads PCD itself (PCL's reader trusts its input): on real files, ascii, binary and
+  // binary_compressed, with extra fields and organised frames, it must give PCL's points exactly.
+  ROMO_REQUIRE_SHARED_DATA("pcl/milk.pcd");
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::SharedData("pcl"))) {
+    if (entry.path().extension() == ".pcd") files.push_back(entry.path().string());
+  }
+  ASSERT_GE(files.size(), 6u);
+  for (const std::string& file : files) {
+    pcl::PointCloud<pcl::PointXYZ> theirs;
+    ASSERT_EQ(pcl::io::loadPCDFile(file, theirs), 0) << file;
+    const PointCloud ours = LoadPcd(file);
+    std::size_t k = 0;
+    for (const auto& p : theirs.points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      ASSERT_LT(k, ours.size()) << file;
+      ASSERT_EQ(ours.xyz(0, static_cast<Eigen::Index>(k)), p.x) << file << " point " << k;
+      ASSERT_EQ(ours.xyz(1, static_cast<Eigen::Index>(k)), p.y) << file << " point " << k;
+      ASSERT_EQ(ours.xyz(2, static_cast<Eigen::Index>(k)), p.z) << file << " point " << k;
+      ++k;
+    }
+    EXPECT_EQ(k, ours.size()) << file;
+  }
+}
+
 TEST(PcdIoTest, MissingFileNamesThePath) {
   try {
     LoadPcd("/nonexistent/romo/cloud.pcd");
@@ -137,8 +166,8 @@ TEST(PcdIoTest, HeadersClaimingMoreThanTheFileHoldsAreRefusedBeforeAllocating) {
   test::WriteFile(dir / "size3.pcd", head + "SIZE 3 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
                                      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
   const std::pair<const char*, const char*> cases[] = {
-      {"ascii.pcd", "100000000000 x 1 points"}, {"binary.pcd", "700000000 x 1 points"},
-      {"size.pcd", "SIZE value '111111111111114'"}, {"size3.pcd", "SIZE 3 is not 1, 2, 4 or 8"}};
+      {"ascii.pcd", "100000000000 x 1 points"}, {"binary.pcd", "data of 700000000 points needs 8400000000 bytes"},
+      {"size.pcd", "SIZE value '111111111111114'"}, {"size3.pcd", "SIZE 3 of field 'x' (TYPE F) is not"}};
   for (const auto& [name, says] : cases) {
     try {
       LoadPcd(dir / name);
@@ -151,6 +180,38 @@ TEST(PcdIoTest, HeadersClaimingMoreThanTheFileHoldsAreRefusedBeforeAllocating) {
   // A sane file still loads.
   SavePcd(MakeCloud(), dir / "ok.pcd");
   EXPECT_EQ(LoadPcd(dir / "ok.pcd").size(), MakeCloud().size());
+}
+
+TEST(PcdIoTest, HeadersPclWouldMisreadAreRefusedNamingTheLine) {
+  // PCL read a line by its first token's prefix and let a second FIELDS line resize the fields
+  // after SIZE set their offsets: that corrupted PCL's heap (fuzz/regressions/pcd). romo's reader
+  // refuses each such header, naming the line.
+  test::ScratchDir dir;
+  const std::string tail = "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nFIELDS x y\nCOUNT 1 1\n" + tail,
+       "line 5: a second FIELDS line (the first is line 2)"},
+      {"VERSION 0.7\nFIELDSX x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nCOLUMNS x y z\n" + tail,
+       "line 2: unknown header keyword 'FIELDSX'"},
+      {"VERSION 0.7\nSIZE 4 4 4\nFIELDS x y z\nTYPE F F F\nCOUNT 1 1 1\n" + tail, "line 2: SIZE before FIELDS"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n" + tail, "line 3: SIZE has 4 entries for 3"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F\nCOUNT 1 1 1\n" + tail, "line 4: TYPE has 2 entries for 3"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nWIDTH 2\nHEIGHT 1\nPOINTS 1\n"
+       "DATA ascii\n1 2 3\n",
+       "line 7: a second WIDTH line"},
+  };
+  int k = 0;
+  for (const auto& [text, says] : cases) {
+    const std::string name = "bad" + std::to_string(k++) + ".pcd";
+    test::WriteFile(dir / name, text);
+    const std::string message = test::ErrorOf([&] { LoadPcd(dir / name); });
+    EXPECT_NE(message.find(name), std::string::npos) << message;
+    EXPECT_NE(message.find(says), std::string::npos) << message;
+  }
+  // Comments and blank lines between keywords are fine.
+  test::WriteFile(dir / "commented.pcd", "# .PCD v0.7\nVERSION 0.7\n\nFIELDS x y z\n# sizes\nSIZE 4 4 4\nTYPE F F F\n"
+                                        "COUNT 1 1 1\n" + tail);
+  EXPECT_EQ(LoadPcd(dir / "commented.pcd").size(), 1u);
 }
 
 TEST(PcdIoTest, SaveIntoMissingFolderFailsWithPath) {

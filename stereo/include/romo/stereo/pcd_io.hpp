@@ -1,5 +1,6 @@
 #pragma once
-/// PCD import/export of romo::PointCloud through PCL I/O, for inspection and test data.
+/// PCD import/export of romo::PointCloud, for inspection and test data: written through PCL I/O,
+/// read by a reader of our own that checks every size before using it (PCL's trusts its input).
 /// Fields written: x y z intensity sigma_z (float32, binary). Fields read: x y z (required),
 /// intensity and sigma_z when present (otherwise 0), any numeric PCD type.
 #include <cstddef>
