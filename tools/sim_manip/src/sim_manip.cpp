@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -64,6 +65,34 @@ struct Box {
   Eigen::Vector3d rgb;
   std::string name;
 };
+
+// Where the ray origin + t d (t > 0) enters the axis-aligned box [lo, hi], and the axis of the
+// face it enters through (slab method); nullopt when it misses or starts inside.
+struct BoxEntry {
+  double t;
+  int axis;
+};
+std::optional<BoxEntry> RayEntersBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& d,
+                                     const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double t0 = 0.0, t1 = kInf;
+  int axis = -1;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-12) {
+      if (origin[a] < lo[a] || origin[a] > hi[a]) return std::nullopt;
+      continue;
+    }
+    double ta = (lo[a] - origin[a]) / d[a], tb = (hi[a] - origin[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > t0) {
+      t0 = ta;
+      axis = a;
+    }
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return std::nullopt;
+  }
+  if (axis < 0) return std::nullopt;
+  return BoxEntry{t0, axis};
+}
 
 }  // namespace
 
@@ -313,27 +342,11 @@ class SimManipScene::Impl {
                        : Eigen::Vector3d(0.62, 0.45, 0.3) * (opt_.slide ? 0.35 + 0.65 * tex : 0.7 + 0.3 * tex);
         }
         for (const Box& b : boxes_) {
-          double t0 = 0.0, t1 = kInf;
-          int axis = -1;
-          bool hit = true;
-          for (int a = 0; a < 3 && hit; ++a) {
-            if (std::abs(d[a]) < 1e-12) {
-              hit = eye_[a] >= b.lo[a] && eye_[a] <= b.hi[a];
-              continue;
-            }
-            double ta = (b.lo[a] - eye_[a]) / d[a], tb = (b.hi[a] - eye_[a]) / d[a];
-            if (ta > tb) std::swap(ta, tb);
-            if (ta > t0) {
-              t0 = ta;
-              axis = a;
-            }
-            t1 = std::min(t1, tb);
-            hit = t0 <= t1;
-          }
-          if (hit && axis >= 0 && t0 < best) {
-            best = t0;
-            const double shade = axis == 2 ? 1.0 : 0.75;
-            const Eigen::Vector3d p = eye_ + t0 * d;
+          const auto entry = RayEntersBox(eye_, d, b.lo, b.hi);
+          if (entry && entry->t < best) {
+            best = entry->t;
+            const double shade = entry->axis == 2 ? 1.0 : 0.75;
+            const Eigen::Vector3d p = eye_ + entry->t * d;
             rgb = b.rgb * shade * (0.85 + 0.15 * ValueNoise(p.x() + p.z(), p.y() - p.z(), 0.01, 13));
           }
         }
@@ -361,25 +374,11 @@ class SimManipScene::Impl {
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         const Eigen::Vector3d d = R_local_P * Ray(u, v);
-        double t0 = 0.0, t1 = kInf;
-        int axis = -1;
-        bool hit = true;
-        for (int a = 0; a < 3 && hit; ++a) {
-          if (std::abs(d[a]) < 1e-12) {
-            hit = std::abs(o[a]) <= kBookHalf[a];
-            continue;
-          }
-          double ta = (-kBookHalf[a] - o[a]) / d[a], tb = (kBookHalf[a] - o[a]) / d[a];
-          if (ta > tb) std::swap(ta, tb);
-          if (ta > t0) {
-            t0 = ta;
-            axis = a;
-          }
-          t1 = std::min(t1, tb);
-          hit = t0 <= t1;
-        }
+        const auto entry = RayEntersBox(o, d, -kBookHalf, kBookHalf);
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        if (!hit || axis < 0 || ((*depth)[i] > 0 && t0 >= (*depth)[i])) continue;
+        if (!entry || ((*depth)[i] > 0 && entry->t >= (*depth)[i])) continue;
+        const double t0 = entry->t;
+        const int axis = entry->axis;
         const Eigen::Vector3d p = o + t0 * d;  // book frame
         // A printed cover: random 8 mm blocks (corners for feature detectors) over fine noise.
         const double qx = p.x() + p.z(), qy = p.y() - p.z();
