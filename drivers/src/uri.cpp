@@ -65,19 +65,23 @@ std::optional<std::string> Uri::Get(const std::string& key) const {
   return it->second;
 }
 
+namespace {
+
+// "source URI sim://parking: 'frames=abc' " + @p what.
+[[noreturn]] void BadValue(const Uri& uri, const std::string& key, const std::string& value, const std::string& what) {
+  Fail("source URI " + uri.scheme + "://" + uri.path + ": '" + key + "=" + value + "' " + what);
+}
+
+}  // namespace
+
 std::optional<long long> Uri::GetInt(const std::string& key, long long min, long long max) const {
   const auto v = Get(key);
   if (!v) return std::nullopt;
   errno = 0;
   char* end = nullptr;
   const long long value = std::strtoll(v->c_str(), &end, 10);
-  if (v->empty() || *end != '\0' || errno == ERANGE) {
-    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not an integer");
-  }
-  if (value < min || value > max) {
-    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is outside " + std::to_string(min) +
-         ".." + std::to_string(max));
-  }
+  if (v->empty() || *end != '\0' || errno == ERANGE) BadValue(*this, key, *v, "is not an integer");
+  if (value < min || value > max) BadValue(*this, key, *v, "is outside " + std::to_string(min) + ".." + std::to_string(max));
   return value;
 }
 
@@ -93,16 +97,12 @@ std::optional<double> Uri::GetDouble(const std::string& key, double min, double 
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(v->c_str(), &end);
-  if (v->empty() || *end != '\0' || errno == ERANGE) {
-    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not a number");
-  }
-  if (!std::isfinite(value)) {
-    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is not a finite number");
-  }
+  if (v->empty() || *end != '\0' || errno == ERANGE) BadValue(*this, key, *v, "is not a number");
+  if (!std::isfinite(value)) BadValue(*this, key, *v, "is not a finite number");
   if (value < min || value > max) {
     std::ostringstream range;
-    range << min << ".." << max;
-    Fail("source URI " + scheme + "://" + path + ": '" + key + "=" + *v + "' is outside " + range.str());
+    range << "is outside " << min << ".." << max;
+    BadValue(*this, key, *v, range.str());
   }
   return value;
 }

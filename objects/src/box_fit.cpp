@@ -99,6 +99,29 @@ Eigen::Matrix<float, 3, 8> Box3::Corners() const {
   return c;
 }
 
+namespace {
+
+// Of a footprint's four names (turned by k * 90 deg, length and width swapped for odd k), the k
+// whose heading is nearest @p hint_yaw_rad, keeping length >= width unless it is nearly square.
+int NearestQuarterTurn(float yaw_rad, float length_m, float width_m, float hint_yaw_rad) {
+  const bool near_square = std::abs(length_m - width_m) < kNearSquareFraction * std::max(length_m, width_m);
+  int best_k = -1;
+  float best_err = 1e9f;
+  for (int k = 0; k < 4; ++k) {
+    const bool swapped = (k % 2) == 1;
+    if (!near_square && (swapped ? width_m < length_m : length_m < width_m)) continue;
+    const float err = std::abs(WrapPi(yaw_rad + static_cast<float>(k) * 0.5f * kPi - hint_yaw_rad));
+    if (err < best_err) {
+      best_err = err;
+      best_k = k;
+    }
+  }
+  ROMO_DEMAND(best_k >= 0);
+  return best_k;
+}
+
+}  // namespace
+
 float CanonicalYaw(float yaw_rad, float* length_m, float* width_m, std::optional<float> hint_yaw_rad) {
   ROMO_THROW_UNLESS(length_m != nullptr && width_m != nullptr);
   if (!std::isfinite(yaw_rad)) Fail("CanonicalYaw: yaw_rad is not finite");
@@ -113,24 +136,12 @@ float CanonicalYaw(float yaw_rad, float* length_m, float* width_m, std::optional
     return WrapHalfPi(yaw_rad);
   }
   if (!std::isfinite(*hint_yaw_rad)) Fail("CanonicalYaw: hint_yaw_rad is not finite");
-  const bool near_square = std::abs(l - w) < kNearSquareFraction * std::max(l, w);
-  float best_yaw = 0.f, best_l = l, best_w = w, best_err = 1e9f;
-  for (int k = 0; k < 4; ++k) {
-    const bool swapped = (k % 2) == 1;
-    const float cl = swapped ? w : l, cw = swapped ? l : w;
-    if (!near_square && cl < cw) continue;
-    const float cand = yaw_rad + static_cast<float>(k) * 0.5f * kPi;
-    const float err = std::abs(WrapPi(cand - *hint_yaw_rad));
-    if (err < best_err) {
-      best_err = err;
-      best_yaw = *hint_yaw_rad + WrapPi(cand - *hint_yaw_rad);
-      best_l = cl;
-      best_w = cw;
-    }
-  }
-  *length_m = best_l;
-  *width_m = best_w;
-  return WrapPi(best_yaw);
+  const int k = NearestQuarterTurn(yaw_rad, l, w, *hint_yaw_rad);
+  if (k % 2 == 1) std::swap(l, w);
+  *length_m = l;
+  *width_m = w;
+  const float cand = yaw_rad + static_cast<float>(k) * 0.5f * kPi;
+  return WrapPi(*hint_yaw_rad + WrapPi(cand - *hint_yaw_rad));
 }
 
 namespace {
@@ -185,26 +196,9 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, std
     box.yaw_rad = HeadingOf(axes);
     return box;
   }
-  // With a hint: of the four names of the box (turns about col(2) by k * 90 deg), the one whose
-  // heading is nearest the hint, keeping length >= width unless the footprint is nearly square
-  // (as CanonicalYaw does for vertical boxes).
-  const float l = box.size.x(), w = box.size.y();
-  const bool near_square = std::abs(l - w) < kNearSquareFraction * std::max(l, w);
-  int best_k = -1;
-  float best_err = 1e9f;
-  for (int k = 0; k < 4; ++k) {
-    Eigen::Matrix3f cand_axes = axes;
-    Eigen::Vector3f cand_size = box.size;
-    TurnAboutThirdAxis(k, &cand_axes, &cand_size);
-    if (!near_square && cand_size.x() < cand_size.y()) continue;
-    const float err = std::abs(WrapPi(HeadingOf(cand_axes) - *hint_yaw_rad));
-    if (err < best_err) {
-      best_err = err;
-      best_k = k;
-    }
-  }
-  ROMO_DEMAND(best_k >= 0);
-  TurnAboutThirdAxis(best_k, &axes, &box.size);
+  // With a hint: the name of the box nearest it, as CanonicalYaw chooses for vertical boxes.
+  TurnAboutThirdAxis(NearestQuarterTurn(HeadingOf(axes), box.size.x(), box.size.y(), *hint_yaw_rad), &axes,
+                     &box.size);
   box.axes = axes;
   box.yaw_rad = WrapPi(HeadingOf(axes));
   return box;

@@ -3,6 +3,7 @@
 // line by its first token's prefix, lets a second FIELDS line resize the fields after SIZE set
 // their offsets, and corrupted its heap on inputs fuzz_pcd found (ASan: bad frees, a broken
 // quarantine) that no single input reproduced. Here every size is checked before it is used.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -26,7 +27,8 @@ struct Field {
   char type = 'F';         // I, U or F
   std::size_t size = 4;    // bytes of one element
   std::size_t count = 1;   // elements
-  std::size_t offset = 0;  // in a packed point (binary) or in a point's values (ascii)
+  std::size_t offset = 0;   // bytes into a packed point (binary, binary_compressed)
+  std::size_t element = 0;  // values into an ascii point line
 };
 
 struct Header {
@@ -124,6 +126,7 @@ Header ParseHeader(const std::string& bytes, const std::string& path) {
       FailAt(path, seen_at["COUNT"], "COUNT " + std::to_string(f.count) + " of field '" + f.name + "' is not 1..4096");
     }
     f.offset = h.point_step;  // both sums stay below 4096 x 8 x fields: no overflow
+    f.element = h.values_per_point;
     h.point_step += f.size * f.count;
     h.values_per_point += f.count;
   }
@@ -253,7 +256,7 @@ class AsciiValues : public PointValues {
     }
   }
   double Get(std::size_t point, const Field& f) const override {
-    return values_[point * per_point_ + f.offset];
+    return values_[point * per_point_ + f.element];
   }
 
  private:
@@ -278,7 +281,7 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
   std::ifstream file(path, std::ios::binary);
   if (!file) Fail("PCD file '" + path + "' cannot be opened");
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  Header h = ParseHeader(bytes, path);
+  const Header h = ParseHeader(bytes, path);
   const Field* fx = FindField(h, "x");
   const Field* fy = FindField(h, "y");
   const Field* fz = FindField(h, "z");
@@ -323,12 +326,6 @@ PointCloud LoadPcd(const std::string& path, PcdLoadStats* stats) {
                            static_cast<double>(available) + 1.0) {
       Fail("PCD file '" + path + "' header claims " + std::to_string(h.width) + " x " + std::to_string(h.height) +
            " points but the file has " + std::to_string(available) + " bytes of ascii data");
-    }
-    // Ascii values are indexed by element, not byte.
-    std::size_t element = 0;
-    for (Field& f : h.fields) {
-      f.offset = element;
-      element += f.count;
     }
     values = std::make_unique<AsciiValues>(bytes, h, path);
   }
