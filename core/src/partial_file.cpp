@@ -34,7 +34,7 @@ std::string KeepInterruptedPartial(const std::string& path) {
     }
     return kept;
   }
-  Fail(partial + ": left by an interrupted writer, and " + stem + ".interrupted-1.." + "1000" + ext +
+  Fail(partial + ": left by an interrupted writer, and " + stem + ".interrupted-1..1000" + ext +
        " are all taken: move them away");
 }
 
