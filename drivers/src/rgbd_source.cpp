@@ -17,7 +17,6 @@
 #include <cstring>
 #include <dirent.h>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <sstream>
 #include <sys/stat.h>
@@ -26,6 +25,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/core/text_file.hpp"
 #include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frame_source.hpp"
 
@@ -119,8 +119,15 @@ std::vector<std::pair<double, std::string>> ReadStampList(const std::string& pat
   return entries;
 }
 
+std::size_t JsonKey(const std::string& text, const std::string& path, const std::string& key) {
+  const std::size_t at = text.find("\"" + key + "\"");
+  if (at == std::string::npos) Fail(path + ": camera JSON without \"" + key + "\"");
+  return at + key.size() + 2;
+}
+
 // The number after "key": in @p text; @throws romo::Error naming @p path when it is missing.
-double JsonNumberAfter(const std::string& text, std::size_t at, const std::string& path, const std::string& key) {
+double JsonNumber(const std::string& text, const std::string& path, const std::string& key) {
+  std::size_t at = JsonKey(text, path, key);
   while (at < text.size() && (std::isspace(static_cast<unsigned char>(text[at])) || text[at] == ':')) ++at;
   char* end = nullptr;
   const double v = at < text.size() ? std::strtod(text.c_str() + at, &end) : 0.0;
@@ -130,21 +137,13 @@ double JsonNumberAfter(const std::string& text, std::size_t at, const std::strin
   return v;
 }
 
-std::size_t JsonKey(const std::string& text, const std::string& path, const std::string& key) {
-  const std::size_t at = text.find("\"" + key + "\"");
-  if (at == std::string::npos) Fail(path + ": camera JSON without \"" + key + "\"");
-  return at + key.size() + 2;
-}
-
 // Open3D PinholeCameraIntrinsic JSON -> one rig with that K (left and right).
 RigCalibration ReadCameraJson(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Fail(path + ": cannot open camera JSON");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = ReadWholeFile(path, path + ": cannot open camera JSON");
   constexpr std::size_t kMaxBytes = 64 * 1024;
   if (text.size() > kMaxBytes) Fail(path + ": camera JSON larger than 64 KiB");
-  const double width = JsonNumberAfter(text, JsonKey(text, path, "width"), path, "width");
-  const double height = JsonNumberAfter(text, JsonKey(text, path, "height"), path, "height");
+  const double width = JsonNumber(text, path, "width");
+  const double height = JsonNumber(text, path, "height");
   std::size_t at = JsonKey(text, path, "intrinsic_matrix");
   at = text.find('[', at);
   const std::size_t close = at == std::string::npos ? at : text.find(']', at);

@@ -123,6 +123,9 @@ Projection Project(const PinholeCamera& cam, const Eigen::Isometry3d& T_cam_worl
   return pr;
 }
 
+// Squared Mahalanobis distance of the innovation @p nu with covariance @p S (eq. 3.4).
+double Chi2(const Eigen::Vector3d& nu, const Eigen::Matrix3d& S) { return nu.dot(S.ldlt().solve(nu)); }
+
 }  // namespace
 
 BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const PinholeCamera& cam,
@@ -187,6 +190,22 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
   for (std::size_t i = 0; i < fresh.size(); ++i) fresh_used[i].assign(fresh[i].xyz_world.cols(), 0);
   std::vector<char> fresh_merged(fresh.size(), 0);
   const int r = params_.search_radius_px;
+  // Whether a stored point of blob @p j, front-most in the pixel neighbourhood of @p pr, lies
+  // within the gate of the observation (@p x, @p cov).
+  const auto near_stored_point = [&](int j, const Projection& pr, const Eigen::Vector3d& x,
+                                     const Eigen::Matrix3d& cov) {
+    if (pr.u < 0) return false;
+    const Blob& blob = blobs_[j];
+    for (int dv = -r; dv <= r; ++dv) {
+      for (int du = -r; du <= r; ++du) {
+        const int u = pr.u + du, v = pr.v + dv;
+        if (u < 0 || v < 0 || u >= w || v >= h) continue;
+        const auto [sj, sq] = zbuf[static_cast<std::size_t>(v) * w + u];
+        if (sj == j && Chi2(x - blob.xyz_world.col(sq), blob.cov_world[sq] + cov) < params_.chi2_gate) return true;
+      }
+    }
+    return false;
+  };
 
   for (int j = 0; j < static_cast<int>(blobs_.size()); ++j) {
     Blob& blob = blobs_[j];
@@ -222,8 +241,7 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
             const auto [fi, fq] = obs_at[static_cast<std::size_t>(v) * w + u];
             if (fi < 0 || !candidate[fi] || fresh_used[fi][fq]) continue;
             const Eigen::Vector3d nu = fresh[fi].xyz_world.col(fq) - pred;
-            const Eigen::Matrix3d S = blob.cov_world[q] + fresh[fi].cov_world[fq];
-            const double chi2 = nu.dot(S.ldlt().solve(nu));
+            const double chi2 = Chi2(nu, blob.cov_world[q] + fresh[fi].cov_world[fq]);
             if (chi2 < best) {
               best = chi2;
               best_i = fi;
@@ -306,20 +324,7 @@ BlobMapUpdate BlobMap::Update(const std::vector<ObservedBlob>& fresh, const Pinh
         if (fresh_used[i][q]) continue;
         fresh_used[i][q] = 1;
         const Eigen::Vector3d& x = fresh[i].xyz_world.col(q);
-        const Projection pr = Project(cam, T_cam_world, x);
-        bool redundant = false;
-        for (int dv = -r; dv <= r && !redundant && pr.u >= 0; ++dv) {
-          for (int du = -r; du <= r && !redundant; ++du) {
-            const int u = pr.u + du, v = pr.v + dv;
-            if (u < 0 || v < 0 || u >= w || v >= h) continue;
-            const auto [sj, sq] = zbuf[static_cast<std::size_t>(v) * w + u];
-            if (sj != j) continue;
-            const Eigen::Vector3d nu = x - blob.xyz_world.col(sq);
-            const Eigen::Matrix3d S = blob.cov_world[sq] + fresh[i].cov_world[q];
-            redundant = nu.dot(S.ldlt().solve(nu)) < params_.chi2_gate;
-          }
-        }
-        if (redundant) {
+        if (near_stored_point(j, Project(cam, T_cam_world, x), x, fresh[i].cov_world[q])) {
           ++out.redundant;
           continue;
         }
