@@ -590,6 +590,19 @@ void Calibration::Save(const std::string& path) const {
   if (std::fclose(file) != 0 || !ok) Fail(path + ": cannot write calibration file");
 }
 
+RigCalibration RgbdSensorRig(const std::string& name, int width_px, int height_px, const Eigen::Matrix3d& K) {
+  constexpr double kDepthToRgbBaselineM = 0.025;  // Kinect v1 / PrimeSense
+  RigCalibration rig;
+  rig.rig_id = 0;
+  rig.name = name;
+  rig.width_px = width_px;
+  rig.height_px = height_px;
+  rig.left.K = K;
+  rig.right.K = K;
+  rig.T << -kDepthToRgbBaselineM, 0, 0;
+  return rig;
+}
+
 std::string SampleCalibrationPath() {
   const std::string relative = "/calibration/romo_sample.yaml";
   std::vector<std::string> dirs;

@@ -30,21 +30,11 @@ constexpr int kInvalidRaw = 2047;  // 11-bit depth: no return
 constexpr double kDefaultFocalPx = 525.0;
 constexpr double kDefaultCxPx = 319.5;
 constexpr double kDefaultCyPx = 239.5;
-constexpr double kIrToRgbBaselineM = 0.025;  // Kinect v1 / PrimeSense: IR and RGB cameras
-
 Calibration DefaultKinectCalibration(int index) {
-  RigCalibration rig;
-  rig.rig_id = 0;
-  rig.name = "kinect" + std::to_string(index);
-  rig.width_px = kWidth;
-  rig.height_px = kHeight;
-  rig.left.K << kDefaultFocalPx, 0, kDefaultCxPx, 0, kDefaultFocalPx, kDefaultCyPx, 0, 0, 1;
-  // Right = the RGB camera beside the depth (IR) camera, 2.5 cm apart on a Kinect v1; romo reads
-  // only the left K (depth), the baseline makes it a valid rig for recordings.
-  rig.right.K = rig.left.K;
-  rig.T << -kIrToRgbBaselineM, 0, 0;
+  Eigen::Matrix3d K;
+  K << kDefaultFocalPx, 0, kDefaultCxPx, 0, kDefaultFocalPx, kDefaultCyPx, 0, 0, 1;
   Calibration c;
-  c.rigs.push_back(rig);
+  c.rigs.push_back(RgbdSensorRig("kinect" + std::to_string(index), kWidth, kHeight, K));
   return c;
 }
 

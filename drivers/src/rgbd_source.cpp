@@ -175,18 +175,9 @@ RigCalibration ReadCameraJson(const std::string& path) {
          "and the centre in the image), got fx=" + std::to_string(fx) + " fy=" + std::to_string(fy) +
          " cx=" + std::to_string(cx) + " cy=" + std::to_string(cy));
   }
-  RigCalibration rig;
-  rig.rig_id = 0;
-  rig.name = "rgbd";
-  rig.width_px = static_cast<int>(width);
-  rig.height_px = static_cast<int>(height);
-  rig.left.K << fx, 0, cx, 0, fy, cy, 0, 0, 1;
-  // Right = the RGB camera, 2.5 cm beside the depth camera on Kinect-class sensors (nominal: the
-  // folder's depth may be registered to colour already); only the left K is read, the baseline
-  // makes it a valid rig for recordings.
-  rig.right.K = rig.left.K;
-  rig.T << -0.025, 0, 0;
-  return rig;
+  Eigen::Matrix3d K;
+  K << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+  return RgbdSensorRig("rgbd", static_cast<int>(width), static_cast<int>(height), K);
 }
 
 // camera*.json / intrinsic*.json in @p folder, name order.

@@ -50,6 +50,11 @@ struct Calibration {
   void Validate(const std::string& origin) const;
 };
 
+/// An RGB-D sensor (Kinect class) as rig 0 of a calibration: @p K is the depth camera's (the one
+/// romo reads); the right camera is the RGB one, a nominal 2.5 cm beside it, which only makes the
+/// rig valid for recordings.
+RigCalibration RgbdSensorRig(const std::string& name, int width_px, int height_px, const Eigen::Matrix3d& K);
+
 /// Path of the sample RoMo calibration shipped with romo (6 rigs, 782x582), in the source tree
 /// or the install tree.
 std::string SampleCalibrationPath();
