@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <sys/stat.h>
 
@@ -26,6 +27,7 @@ constexpr int kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
 constexpr std::int32_t kMaxChannelBytes = 1024;
 // Larger than any frame set we write (12 raw 16-bit 782x582 images are ~11 MB).
 constexpr std::int32_t kMaxEventBytes = 1 << 30;
+constexpr std::int64_t kMaxTimestampUs = std::numeric_limits<std::int64_t>::max() / 1000;
 
 template <typename Msg>
 std::vector<std::uint8_t> Encode(const Msg& msg) {
@@ -351,29 +353,32 @@ void EventFileReader::SeekTo(std::int64_t offset) {
   offset_ = offset;
 }
 
+ReadResult EventFileReader::Damaged(ReadResult result, const char* why) {
+  std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
+  damage_ = why;
+  return result;
+}
+
 ReadResult EventFileReader::Next(LogEvent* event) {
   std::uint8_t header[kEventHeaderBytes];
   const std::size_t got = std::fread(header, 1, sizeof header, file_);
   if (got == 0 && std::feof(file_)) return ReadResult::kEnd;
-  if (got < 4) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kTruncated;
-  }
+  if (got < 4) return Damaged(ReadResult::kTruncated, "event header cut short");
   if (BigEndian32(header) != kLogSyncWord) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kCorrupt;
+    return Damaged(ReadResult::kCorrupt, "no event sync word 0xEDA1DA01");
   }
-  if (got < sizeof header) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kTruncated;
-  }
+  if (got < sizeof header) return Damaged(ReadResult::kTruncated, "event header cut short");
   const std::int64_t timestamp = BigEndian64(header + 12);
   const auto channel_len = static_cast<std::int32_t>(BigEndian32(header + 20));
   const auto data_len = static_cast<std::int32_t>(BigEndian32(header + 24));
   if (channel_len <= 0 || channel_len > kMaxChannelBytes || data_len < 0 ||
       data_len > kMaxEventBytes) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kCorrupt;
+    return Damaged(ReadResult::kCorrupt, "impossible channel or data length in an event header");
+  }
+  // Event times are microseconds since 1970 and readers turn them into int64 nanoseconds:
+  // a negative one or one past year 2262 is a damaged header, not a time.
+  if (timestamp < 0 || timestamp > kMaxTimestampUs) {
+    return Damaged(ReadResult::kCorrupt, "event time outside 1970..2262");
   }
   // The lengths come from the file: one past its end means a cut (or damaged) event, reported
   // without allocating what the header claims (up to 1 GiB for a few bytes of input).
@@ -381,15 +386,13 @@ ReadResult EventFileReader::Next(LogEvent* event) {
   const std::int64_t size_now =
       ::fstat(::fileno(file_), &st) == 0 ? static_cast<std::int64_t>(st.st_size) : file_size_;
   if (offset_ + kEventHeaderBytes + channel_len + data_len > size_now) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kTruncated;
+    return Damaged(ReadResult::kTruncated, "event runs past the end of the file");
   }
   event->channel.resize(static_cast<std::size_t>(channel_len));
   event->data.resize(static_cast<std::size_t>(data_len));
   if (std::fread(event->channel.data(), 1, event->channel.size(), file_) != event->channel.size() ||
       std::fread(event->data.data(), 1, event->data.size(), file_) != event->data.size()) {
-    std::fseek(file_, static_cast<long>(offset_), SEEK_SET);
-    return ReadResult::kTruncated;
+    return Damaged(ReadResult::kTruncated, "event runs past the end of the file");
   }
   event->timestamp_us = timestamp;
   offset_ += kEventHeaderBytes + channel_len + data_len;

@@ -52,9 +52,14 @@ class EventFileReader {
   void SeekTo(std::int64_t offset);
   std::int64_t file_size() const { return file_size_; }
   const std::string& path() const { return path_; }
+  /// What was wrong with the event at offset() after a kTruncated/kCorrupt.
+  const char* damage() const { return damage_; }
 
  private:
+  ReadResult Damaged(ReadResult result, const char* why);
+
   std::string path_;
+  const char* damage_ = "";
   std::FILE* file_ = nullptr;
   std::int64_t offset_ = 0;
   std::int64_t file_size_ = 0;

@@ -45,8 +45,8 @@ TypeRegistry& Types() {
 }
 
 // The start of a corrupt region at byte 0 means the file never was an LCM log.
-[[noreturn]] void NotALog(const std::string& path) {
-  Fail(path + ": not an LCM log file (no event sync word 0xEDA1DA01 at byte 0)");
+[[noreturn]] void NotALog(const lcm_codec::EventFileReader& reader) {
+  Fail(reader.path() + ": not an LCM log file (" + reader.damage() + " at byte 0)");
 }
 
 }  // namespace
@@ -91,7 +91,7 @@ std::int64_t ScanEvents(const std::string& path,
       visit(event);
       continue;
     }
-    if (result == ReadResult::kCorrupt && reader.offset() == 0) NotALog(path);
+    if (result == ReadResult::kCorrupt && reader.offset() == 0) NotALog(reader);
     return result == ReadResult::kEnd ? -1 : reader.offset();
   }
 }
@@ -121,7 +121,7 @@ class LogReader::Impl {
     LogEvent event;
     for (int i = 0; i < kCalibrationScanEvents; ++i) {
       const ReadResult result = reader_.Next(&event);
-      if (result == ReadResult::kCorrupt && reader_.offset() == 0) NotALog(path);
+      if (result == ReadResult::kCorrupt && reader_.offset() == 0) NotALog(reader_);
       if (result != ReadResult::kEvent) break;
       if (i == 0) first_timestamp_us_ = event.timestamp_us;
       if (event.channel == kCalibrationChannel) {
@@ -164,7 +164,8 @@ class LogReader::Impl {
       truncation_offset_ = reader_.offset();
       status_.events.push_back(reader_.path() + ": log " +
                                (result == ReadResult::kTruncated ? "truncated" : "corrupt") +
-                               " at byte " + std::to_string(truncation_offset_) + " of " +
+                               " at byte " + std::to_string(truncation_offset_) + " (" +
+                               reader_.damage() + ") of " +
                                std::to_string(reader_.file_size()) +
                                "; every complete event before it was read");
     }

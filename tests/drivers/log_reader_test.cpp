@@ -280,6 +280,27 @@ TEST(LogReaderTest, CorruptEventStopsReadingThere) {
   EXPECT_EQ(reader.truncation_offset(), static_cast<std::int64_t>(bytes_after[1]));
 }
 
+TEST(LogReaderTest, EventTimePastYear2262IsDamageNotATime) {
+  test::ScratchDir dir;
+  std::vector<std::uint64_t> bytes_after;
+  WriteLog(dir / "run.lcmlog", 3, ImageEncoding::kRaw, &bytes_after);
+  {
+    // 0x0A00... us overflows int64 nanoseconds; the header's time field starts at byte 12.
+    std::fstream f(dir / "run.lcmlog", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(bytes_after[1] + 12));
+    const char huge_time[8] = {0x0A, 0, 0, 0, 0, 0, 0, 0};
+    f.write(huge_time, sizeof huge_time);
+  }
+  LogReader reader(dir / "run.lcmlog");
+  EXPECT_EQ(ReadAll(&reader).size(), 2u);
+  EXPECT_EQ(reader.truncation_offset(), static_cast<std::int64_t>(bytes_after[1]));
+  ASSERT_FALSE(reader.status().events.empty());
+  EXPECT_NE(reader.status().events[0].find("corrupt at byte " + std::to_string(bytes_after[1]) +
+                                           " (event time outside 1970..2262)"),
+            std::string::npos)
+      << reader.status().events[0];
+}
+
 TEST(LogReaderTest, GarbageMissingAndEmptyFiles) {
   test::ScratchDir dir;
   std::string garbage(4096, '\0');
