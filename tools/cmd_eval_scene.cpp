@@ -13,6 +13,7 @@ namespace {
 struct EvalSceneOptions {
   std::string log;
   bool json = false;
+  bool misses = false;
   double range_m = 15.0;
 };
 }  // namespace
@@ -23,12 +24,14 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   CLI::App* cmd = eval.add_subcommand("scene", "Score a run's outputs log against the simulator's ground truth");
   cmd->add_option("--log", opts->log, "outputs.lcmlog of `romo run` / `romo replay` of a simulated scene")->required();
   cmd->add_flag("--json", opts->json, "print one JSON object");
+  cmd->add_flag("--misses", opts->misses, "also list each visible car or pedestrian missed, and what was nearest");
   cmd->add_option("--range", opts->range_m, "score objects within this range of the ego, m")->capture_default_str();
   cmd->callback([opts] {
     pipeline::SceneEvalParams p;
     p.range_m = opts->range_m;
     const pipeline::SceneEval e = pipeline::EvaluateSceneLog(opts->log, p);
     std::printf("%s\n", opts->json ? e.ToJson().c_str() : e.ToText().c_str());
+    if (opts->misses) std::printf("%s", e.MissesText().c_str());
   });
 });
 

@@ -208,7 +208,8 @@ namespace {
 
 // FitVerticalBox, or with @p fixed_yaw_rad the rectangle along that heading (no search).
 Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
-                 std::optional<float> hint_yaw_rad, float trim_fraction, std::optional<float> fixed_yaw_rad) {
+                 std::optional<float> hint_yaw_rad, float trim_fraction, std::optional<float> fixed_yaw_rad,
+                 HeadingCriterion criterion = HeadingCriterion::kSmallestArea) {
   CheckIndices(xyz, indices, "FitVerticalBox");
   if (!(up.allFinite() && std::abs(up.norm() - 1.f) < 1e-3f)) {
     std::ostringstream msg;
@@ -256,7 +257,19 @@ Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, c
     }
     const auto [a_lo, a_hi] = TrimmedRange(along, trim);
     const auto [b_lo, b_hi] = TrimmedRange(across, trim);
-    const float area = (a_hi - a_lo) * (b_hi - b_lo);
+    float area = (a_hi - a_lo) * (b_hi - b_lo);
+    if (criterion == HeadingCriterion::kEdgeCloseness) {
+      // Closeness (L-shape fitting): sum of 1 / distance to the nearest side, floored so that
+      // points within the noise of a side count alike; the cost minimised is its negative.
+      constexpr float kNoiseFloorM = 0.1f;
+      float closeness = 0.f;
+      for (std::size_t k = 0; k < along.size(); ++k) {
+        const float to_side = std::min(std::min(along[k] - a_lo, a_hi - along[k]),
+                                       std::min(across[k] - b_lo, b_hi - across[k]));
+        closeness += 1.f / std::max(to_side, kNoiseFloorM);
+      }
+      area = -closeness;
+    }
     // Ties (and degenerate, zero-area footprints) keep the longest side as the heading.
     if (area < best_area - 1e-9f || (std::abs(area - best_area) <= 1e-9f && a_hi - a_lo > best_l)) {
       best_area = area;
@@ -310,8 +323,8 @@ Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, c
 }  // namespace
 
 Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
-                    std::optional<float> hint_yaw_rad, float trim_fraction) {
-  return FitVertical(xyz, indices, up, hint_yaw_rad, trim_fraction, std::nullopt);
+                    std::optional<float> hint_yaw_rad, float trim_fraction, HeadingCriterion criterion) {
+  return FitVertical(xyz, indices, up, hint_yaw_rad, trim_fraction, std::nullopt, criterion);
 }
 
 Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,

@@ -75,6 +75,12 @@ std::vector<Reading> Readings(const Footprint& f, const ViewCompletionParams& pa
     const double c[2] = {std::abs(f.axis[0].dot(f.sight)), std::abs(f.axis[1].dot(f.sight))};
     if (std::max(c[0], c[1]) >= std::cos(params.truncation_angle_deg * kPi / 180.0)) {
       readings.push_back(ReadTruncated(f, c[0] >= c[1] ? 0 : 1, depth_spread_m));
+    } else if (params.corner_angle_deg > 45.0 &&
+               std::min(c[0], c[1]) >= std::cos(params.corner_angle_deg * kPi / 180.0)) {
+      // Seen at a corner: either side may be the one cut off (by a neighbour, the image border
+      // or the end of the stereo range); the classes' sizes tell which.
+      readings.push_back(ReadTruncated(f, 0, depth_spread_m));
+      readings.push_back(ReadTruncated(f, 1, depth_spread_m));
     }
     const int thin = f.extent[0] <= f.extent[1] ? 0 : 1;
     const bool face = f.extent[thin] <= params.face_max_thickness_m &&

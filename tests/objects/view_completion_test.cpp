@@ -89,6 +89,36 @@ TEST(ViewCompletionTest, CornerViewsAndImplausibleBoxesAreNotCompleted) {
   EXPECT_TRUE(w.box.center.isApprox(wall.center));
 }
 
+TEST(ViewCompletionTest, CornerReadingsLetEitherSideBeTheCutOne) {
+  const Atlas atlas = Load();
+  // A parked car's end (1.75 m, along y) and the 1.65 m of its side a neighbour leaves in view,
+  // seen from the origin 41 degrees off the side: just outside the 40 degree truncation cone, so
+  // by default both faces read as whole and 1.65 x 1.75 m is no car.
+  const float at = 41.f * kPi / 180.f;
+  const Box3 seen = MakeBox({6.f * std::cos(at), 6.f * std::sin(at)}, 1.65f, 1.75f, 1.45f, 0.f);
+  const ViewedBox whole = ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f::Zero());
+  EXPECT_NE(NameOf(atlas, whole.classification), "car");
+  EXPECT_FALSE(whole.completed);
+
+  ViewCompletionParams corner;
+  corner.corner_angle_deg = 50.0;
+  const ViewedBox cut = ClassifyFromViewpoint(atlas, seen, Eigen::Vector2f::Zero(), corner);
+  EXPECT_EQ(NameOf(atlas, cut.classification), "car");
+  ASSERT_TRUE(cut.completed);
+  // The side (x axis, 1.65 m) was the cut one: completed to the car mean away from the viewer,
+  // its near end kept; the end's 1.75 m stays the width.
+  const double car_length = atlas.classes()[atlas.Require("car")].length.mean_m;
+  EXPECT_NEAR(cut.box.size.x(), car_length, 1e-5);
+  EXPECT_NEAR(cut.box.size.y(), 1.75, 1e-5);
+  EXPECT_NEAR(cut.box.center.x(), seen.center.x() - 0.825 + car_length / 2, 1e-4);
+  EXPECT_NEAR(cut.box.center.y(), seen.center.y(), 1e-5);
+  // Exactly at a corner (45 degrees) the default still reads both faces as whole.
+  const float diagonal = kPi / 4;
+  const Box3 at_45 = MakeBox({6.f * std::cos(diagonal), 6.f * std::sin(diagonal)}, 1.65f, 1.75f, 1.45f, 0.f);
+  EXPECT_FALSE(ClassifyFromViewpoint(atlas, at_45, Eigen::Vector2f::Zero()).completed);
+  EXPECT_TRUE(ClassifyFromViewpoint(atlas, at_45, Eigen::Vector2f::Zero(), corner).completed);
+}
+
 TEST(ViewCompletionTest, ViewpointDecidesWhichFaceWasSeen) {
   const Atlas atlas = Load();
   // The front 0.9 m of a car (its front and the start of a side), 1.8 m across, at (3, 3): from

@@ -1,15 +1,21 @@
-// Accuracy of the whole stack on the simulated parking scene `romo run` uses by default (seed 1,
-// 40 frames, half resolution): detection, boxes, tracks and the parking slot against the scene's
-// ground truth, scored by `romo eval scene`.
+// Accuracy of the whole stack on the simulated parking scene `romo run` uses (40 frames, half
+// resolution), over seeds 1-5 (seed 1 is `romo run`'s default): detection, boxes, tracks and the
+// parking slot against the scene's ground truth, scored by `romo eval scene`.
 //
-// Where the targets are met (slot yaw within 3 degrees, the too-narrow bay never reported
-// feasible) they are asserted as such. Where they are not yet met (car and pedestrian
-// recall/precision >= 0.95, slot centre within 0.15 m; see README "Accuracy") the figures of
-// today's main are asserted as floors, each a few sightings below the figure measured, so that a
-// change that loses accuracy fails here instead of passing unnoticed. The run is deterministic
-// for a build (fixed seed, rendering and matching independent of thread count); the margins
-// cover compiler and library differences in floating point.
+// One seed's figures move by several sightings with any change to the stack (which blob a track
+// takes, which view a parked car is remembered from); the mean over five scenes is what a change
+// is judged by. Where the targets are met (slot yaw within 3 degrees, the too-narrow bay
+// never reported feasible) they are asserted in every scene. Where they are not yet met (car and
+// pedestrian recall/precision >= 0.95, box centre within 0.2 m, slot centre within 0.15 m; see
+// README "Accuracy") today's five-seed means are asserted as floors a little below the figures
+// measured, so that a change that loses accuracy fails here instead of passing unnoticed. Each
+// run is deterministic for a build (fixed seed, rendering and matching independent of thread
+// count); the margins cover compiler and library differences in floating point.
 #include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 #include "romo/pipeline/scene_eval.hpp"
 #include "test_support.hpp"
@@ -17,48 +23,90 @@
 namespace romo::pipeline {
 namespace {
 
-TEST(AccuracyTest, DefaultParkingSceneMeetsItsTargetsOrTodaysFloors) {
-  romo::test::ScratchDir dir;
-  const auto run = romo::test::RunRomo("run --no-pictures --out " + dir.path());
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const SceneEval e = EvaluateSceneLog(dir / "outputs.lcmlog");
-  std::printf("FIGURE accuracy: car P %.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld), box centre "
-              "%.3f m, ID switches %lld, slot %lld/%lld centre %.3f m yaw %.2f deg, narrow feasible %lld\n",
-              e.car.precision(), e.car.recall(), static_cast<long long>(e.car.matched_truths),
-              static_cast<long long>(e.car.truths), e.pedestrian.precision(), e.pedestrian.recall(),
-              static_cast<long long>(e.pedestrian.matched_truths), static_cast<long long>(e.pedestrian.truths),
-              e.box_center_err_m_median, static_cast<long long>(e.id_switches),
-              static_cast<long long>(e.slot_found_frames), static_cast<long long>(e.slot_visible_frames),
-              e.slot_center_err_m, e.slot_yaw_err_deg, static_cast<long long>(e.narrow_reported_feasible));
-  std::printf("FIGURE accuracy, objects the cameras can see (>= %.0f %% of their facing surface): car P %.3f R %.3f "
-              "(%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld)\n",
-              100 * SceneEvalParams{}.min_visible_fraction, e.car_visible.precision(), e.car_visible.recall(),
-              static_cast<long long>(e.car_visible.matched_truths), static_cast<long long>(e.car_visible.truths),
-              e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
-              static_cast<long long>(e.pedestrian_visible.matched_truths),
-              static_cast<long long>(e.pedestrian_visible.truths));
-  ASSERT_EQ(e.frames, 40);
-  ASSERT_TRUE(e.visibility_scored) << "romo run writes the calibration into its outputs log";
+constexpr int kSeeds = 5;
 
-  // Targets met.
-  EXPECT_LE(e.slot_yaw_err_deg, 3.0);
-  EXPECT_EQ(e.narrow_reported_feasible, 0);
-  // Floors (measured with lone faces read as such, hidden parked cars remembered, people in
-  // tandem split, coasting fragments no longer cars and walls framed by nearer cars unclassified:
-  // car P 0.924 R 0.565, pedestrian P 0.865 R 0.750, centre 0.226 m, slot 31/32 at 0.218 m).
-  // About 5 sightings of 300 (cars) and 200 (pedestrians) of margin.
-  EXPECT_GE(e.car.recall(), 0.55);
-  EXPECT_GE(e.car.precision(), 0.89);
-  EXPECT_GE(e.pedestrian.recall(), 0.72);
-  EXPECT_GE(e.pedestrian.precision(), 0.84);
-  EXPECT_LE(e.box_center_err_m_median, 0.24);
-  EXPECT_GE(e.slot_found_frames, e.slot_visible_frames - 2);
-  EXPECT_LE(e.slot_center_err_m, 0.24);
-  // Hidden objects (about 40 car and 25 pedestrian sightings) are neither missed nor found there.
-  EXPECT_LT(e.car_visible.truths, e.car.truths);
-  EXPECT_GE(e.car_visible.recall(), e.car.recall());
-  EXPECT_GE(e.car_visible.recall(), 0.61);
-  EXPECT_GE(e.pedestrian_visible.recall(), 0.77);
+struct Means {
+  double car_p = 0, car_r = 0, ped_p = 0, ped_r = 0, car_visible_r = 0, ped_visible_r = 0;
+  double centre_m = 0, car_yaw_deg = 0, slot_centre_m = 0;
+  long long slot_found = 0, slot_visible = 0;
+
+  void Add(const SceneEval& e) {
+    car_p += e.car.precision() / kSeeds;
+    car_r += e.car.recall() / kSeeds;
+    ped_p += e.pedestrian.precision() / kSeeds;
+    ped_r += e.pedestrian.recall() / kSeeds;
+    car_visible_r += e.car_visible.recall() / kSeeds;
+    ped_visible_r += e.pedestrian_visible.recall() / kSeeds;
+    centre_m += e.box_center_err_m_median / kSeeds;
+    car_yaw_deg += e.car_yaw_err_deg_median / kSeeds;
+    slot_centre_m += e.slot_center_err_m / kSeeds;
+    slot_found += e.slot_found_frames;
+    slot_visible += e.slot_visible_frames;
+  }
+};
+
+TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
+  Means mean;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    romo::test::ScratchDir dir;
+    const auto run = romo::test::RunRomo("run --no-pictures --seed " + std::to_string(seed) + " --out " + dir.path());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const SceneEval e = EvaluateSceneLog(dir / "outputs.lcmlog");
+    std::printf("FIGURE accuracy seed %d: car P %.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld), box "
+                "centre %.3f m, car yaw %.1f deg, ID switches %lld, slot %lld/%lld centre %.3f m yaw %.2f deg, "
+                "narrow feasible %lld\n",
+                seed, e.car.precision(), e.car.recall(), static_cast<long long>(e.car.matched_truths),
+                static_cast<long long>(e.car.truths), e.pedestrian.precision(), e.pedestrian.recall(),
+                static_cast<long long>(e.pedestrian.matched_truths), static_cast<long long>(e.pedestrian.truths),
+                e.box_center_err_m_median, e.car_yaw_err_deg_median, static_cast<long long>(e.id_switches),
+                static_cast<long long>(e.slot_found_frames), static_cast<long long>(e.slot_visible_frames),
+                e.slot_center_err_m, e.slot_yaw_err_deg, static_cast<long long>(e.narrow_reported_feasible));
+    std::printf("FIGURE accuracy seed %d, objects the cameras can see (>= %.0f %% of their facing surface): car P "
+                "%.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld)\n",
+                seed, 100 * SceneEvalParams{}.min_visible_fraction, e.car_visible.precision(), e.car_visible.recall(),
+                static_cast<long long>(e.car_visible.matched_truths), static_cast<long long>(e.car_visible.truths),
+                e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
+                static_cast<long long>(e.pedestrian_visible.matched_truths),
+                static_cast<long long>(e.pedestrian_visible.truths));
+    ASSERT_EQ(e.frames, 40);
+    ASSERT_TRUE(e.visibility_scored) << "romo run writes the calibration into its outputs log";
+    // Targets met, in every scene.
+    EXPECT_LE(e.slot_yaw_err_deg, 3.0);
+    EXPECT_EQ(e.narrow_reported_feasible, 0);
+    // Hidden objects (about 40 car and 25 pedestrian sightings a scene) are neither missed nor
+    // found there.
+    EXPECT_LT(e.car_visible.truths, e.car.truths);
+    EXPECT_GE(e.car_visible.recall(), e.car.recall());
+    // `--misses` lists exactly the visible truths missed and the detections matched to none.
+    std::int64_t missed = 0, false_alarms = 0;
+    for (const ClassScore* c : {&e.car_visible, &e.pedestrian_visible}) {
+      missed += c->truths - c->matched_truths;
+      false_alarms += c->detections - c->matched_detections;
+    }
+    EXPECT_EQ(static_cast<std::int64_t>(e.misses.size()), missed);
+    EXPECT_EQ(static_cast<std::int64_t>(e.false_alarms.size()), false_alarms);
+    mean.Add(e);
+  }
+  std::printf("FIGURE accuracy, mean of seeds 1-%d: car P %.3f R %.3f (visible R %.3f), pedestrian P %.3f R %.3f "
+              "(visible R %.3f), box centre %.3f m, car yaw %.1f deg, slot %lld/%lld centre %.3f m\n",
+              kSeeds, mean.car_p, mean.car_r, mean.car_visible_r, mean.ped_p, mean.ped_r, mean.ped_visible_r,
+              mean.centre_m, mean.car_yaw_deg, mean.slot_found, mean.slot_visible, mean.slot_centre_m);
+  // Floors: five-seed means measured with corner readings, edge-closeness headings, neighbouring
+  // car ends split and remembered footprints preferred (car P 0.830 R 0.566, visible R 0.629;
+  // pedestrian P 0.681 R 0.695, visible R 0.749; centre 0.209 m; car yaw 4.5 deg; slot 157/160 at
+  // 0.175 m). Before those: car P 0.821 R 0.548, pedestrian P 0.686 R 0.713, centre 0.229 m, car
+  // yaw 12.3 deg, slot 159/160 at 0.184 m. About 1.5 % (5 of 300 sightings a scene) of margin.
+  EXPECT_GE(mean.car_p, 0.815);
+  EXPECT_GE(mean.car_r, 0.55);
+  EXPECT_GE(mean.car_visible_r, 0.61);
+  EXPECT_GE(mean.ped_p, 0.665);
+  EXPECT_GE(mean.ped_r, 0.68);
+  EXPECT_GE(mean.ped_visible_r, 0.73);
+  EXPECT_LE(mean.centre_m, 0.22);
+  EXPECT_LE(mean.car_yaw_deg, 6.0);
+  EXPECT_GE(mean.slot_found, mean.slot_visible - 5);
+  EXPECT_LE(mean.slot_centre_m, 0.19);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -280,6 +281,49 @@ TEST(PipelineTest, AWallSeenThroughTheGapBetweenTwoCarsIsNotACar) {
   EXPECT_EQ(wall_class(one_side), "car");
 }
 
+TEST(PipelineTest, TheEndsOfTwoNeighbouringCarsBridgedByStereoAreTwoCars) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // Two parked cars' ends 10 m ahead, 1.8 m wide each and 0.8 m apart, as the front camera sees
+  // them; stereo edge fattening leaves a sparse bridge of matches at their depth across the gap
+  // (6 % of a face's density, dense enough to hold at the re-clustering's 7.5 cm leaves), so they come
+  // as one 4.4 m blob: a car's side to the box fit.
+  const std::pair<Eigen::Vector2f, Eigen::Vector2f> left{{10.f, 0.4f}, {10.f, 2.2f}},
+      right{{10.f, -2.2f}, {10.f, -0.4f}};
+  auto scene = [&] {
+    RigInput in = FacesAhead({left, right});
+    for (float y = -0.4f; y <= 0.4f; y += 0.05f) {
+      for (float z = 0.2f; z <= 1.4f; z += 0.3f) in.cloud.PushBack({10.f, y, z}, 0.15f, 50.f);
+    }
+    return in;
+  };
+  auto cars = [](const FrameResult& r) {
+    std::vector<planning_iface::Obstacle> found;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.class_name == "car") found.push_back(o);
+    }
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.center_m.y() < b.center_m.y(); });
+    return found;
+  };
+  PipelineParams whole;
+  whole.face_pair_min_length_m = 0.0;
+  const std::vector<planning_iface::Obstacle> one =
+      cars(Pipeline(calibration, whole).ProcessClouds(1000, 1, {scene()}, std::nullopt, std::nullopt));
+  ASSERT_EQ(one.size(), 1u) << "the two ends must read as one car's side for this test";
+  EXPECT_LT(std::abs(one[0].center_m.y()), 0.3) << "boxed across both, a metre and more off each";
+
+  const std::vector<planning_iface::Obstacle> two =
+      cars(Pipeline(calibration, PipelineParams{}).ProcessClouds(1000, 1, {scene()}, std::nullopt, std::nullopt));
+  ASSERT_EQ(two.size(), 2u);
+  const double car_length = 4.4;  // Atlas mean: what each end is completed to
+  for (int k = 0; k < 2; ++k) {
+    // Each end completed away from the viewer: 1.3 m off the row's middle, half a car length
+    // behind its face (the face's +-0.3 m depth noise and the 0.1 m voxels within 0.3 m).
+    EXPECT_NEAR(two[k].center_m.y(), k == 0 ? -1.3 : 1.3, 0.3);
+    EXPECT_NEAR(two[k].center_m.x(), 10.0 + car_length / 2, 0.4);
+    EXPECT_NEAR(two[k].size_m.y(), 1.8, 0.4);
+  }
+}
+
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, PipelineParams{});
@@ -314,6 +358,17 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.tandem_min_length_m = 0.9;
   params.framed_end_gap_deg = 90.0;
   EXPECT_THROW(params.Validate(), romo::Error);
+  params.framed_end_gap_deg = 6.0;
+  params.face_pair_gap_density = 0.0;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.face_pair_gap_density = 0.35;
+  params.edge_heading_min_length_m = -1.0;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.edge_heading_min_length_m = 1.5;
+  params.completion.corner_angle_deg = 30.0;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.completion.corner_angle_deg = 50.0;
+  EXPECT_NO_THROW(params.Validate());
 }
 
 TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
@@ -325,7 +380,7 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   }
   const std::string eval = romo::test::ReadFile(dir / "eval.json");
   for (const char* key : {"\"frames\":2", "\"car\"", "\"pedestrian\"", "\"box_center_err_m_median\"",
-                          "\"id_switches\"", "\"prediction\"", "\"slot\"", "\"narrow_reported_feasible\""}) {
+                          "\"box_size_err_m_median\"", "\"car_yaw_err_deg_median\"", "\"id_switches\"", "\"prediction\"", "\"slot\"", "\"narrow_reported_feasible\""}) {
     EXPECT_NE(eval.find(key), std::string::npos) << key << " in " << eval;
   }
   // The outputs log spans the run (the calibration is stamped like the first frame, not at 0) and
@@ -342,6 +397,17 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   const auto json = romo::test::RunRomo("eval scene --json --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(json.exit_code, 0) << json.err;
   EXPECT_NE(json.out.find("\"frames\":2"), std::string::npos) << json.out;
+  // --misses: after the summary, one line per missed or false sighting, each naming its frame.
+  const auto misses = romo::test::RunRomo("eval scene --misses --log " + (dir / "outputs.lcmlog"));
+  EXPECT_EQ(misses.exit_code, 0) << misses.err;
+  const std::size_t listed = misses.out.find("\nframe ");
+  ASSERT_NE(listed, std::string::npos) << "a quarter-resolution 2-frame run misses something: " << misses.out;
+  std::istringstream lines(misses.out.substr(listed + 1));
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty()) continue;
+    EXPECT_EQ(line.rfind("frame ", 0), 0u) << line;
+    EXPECT_TRUE(line.find(" car ") != std::string::npos || line.find(" pedestrian ") != std::string::npos) << line;
+  }
   // A recording without calibration is refused with a clear message.
   romo::test::WriteFile(dir / "empty.lcmlog", "");
   const auto bad = romo::test::RunRomo("replay " + (dir / "empty.lcmlog") + " --out " + (dir / "x"));

@@ -26,6 +26,9 @@ double MsSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// An axis this aligned with the sight line (cos 45 deg) is nearer it than across it.
+constexpr float kCos45 = 0.7071f;
+
 double YawOf(const Eigen::Isometry3d& T) {
   const Eigen::Vector3d x = T.rotation().col(0);
   return std::atan2(x.y(), x.x());
@@ -110,7 +113,45 @@ std::array<std::vector<int>, 2> SplitAlong(const PointCloud& cloud, const std::v
   return halves;
 }
 
+// Where along @p axis the points of @p blob are sparsest, at least @p margin_m inside both ends,
+// when that stretch (0.1 m bins, averaged over 0.3 m) holds less than @p max_density of the
+// blob's median bin; nothing otherwise.
+std::optional<float> SparsestStretch(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& axis,
+                                     float margin_m, double max_density) {
+  constexpr float kBinM = 0.1f;
+  std::vector<float> along;
+  along.reserve(blob.size());
+  for (int i : blob) along.push_back(axis.dot(cloud.xyz.col(i)));
+  const auto [lo_it, hi_it] = std::minmax_element(along.begin(), along.end());
+  const float lo = *lo_it;
+  const int bins = static_cast<int>((*hi_it - lo) / kBinM) + 1;
+  const int margin_bins = static_cast<int>(margin_m / kBinM);
+  if (bins < 2 * margin_bins + 3) return std::nullopt;
+  std::vector<int> count(static_cast<std::size_t>(bins), 0);
+  for (float v : along) ++count[static_cast<std::size_t>((v - lo) / kBinM)];
+  std::vector<int> sorted = count;
+  std::nth_element(sorted.begin(), sorted.begin() + bins / 2, sorted.end());
+  const double median = sorted[static_cast<std::size_t>(bins / 2)];
+  int best = -1;
+  double best_density = max_density * median;
+  for (int b = margin_bins; b < bins - margin_bins; ++b) {
+    const double density = (count[b - 1] + count[b] + count[b + 1]) / 3.0;
+    if (density < best_density) {
+      best_density = density;
+      best = b;
+    }
+  }
+  if (best < 0) return std::nullopt;
+  return lo + (static_cast<float>(best) + 0.5f) * kBinM;
+}
+
 }  // namespace
+
+objects::ViewCompletionParams PipelineParams::CarParkCompletion() {
+  objects::ViewCompletionParams p;
+  p.corner_angle_deg = 50.0;
+  return p;
+}
 
 mapping::SegmentationParams PipelineParams::DefaultSegmentation() {
   mapping::SegmentationParams p;
@@ -174,12 +215,23 @@ void PipelineParams::Validate() const {
          std::to_string(framed_occluder_margin_m) + " m >= 0, end gap " + std::to_string(framed_end_gap_deg) +
          " deg in (0, 45))");
   }
+  if (!(edge_heading_min_length_m >= 0)) {
+    Fail("pipeline: edge_heading_min_length_m must be >= 0, got " + std::to_string(edge_heading_min_length_m));
+  }
+  if (!(face_pair_min_length_m >= 0 && face_pair_gap_density > 0 && face_pair_gap_density <= 1)) {
+    Fail("pipeline: face_pair_min_length_m must be >= 0 and face_pair_gap_density in (0, 1], got " +
+         std::to_string(face_pair_min_length_m) + " m, " + std::to_string(face_pair_gap_density));
+  }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
   }
   if (!(completion.truncation_angle_deg >= 0 && completion.truncation_angle_deg < 45)) {
     Fail("pipeline: completion.truncation_angle_deg must be in [0, 45), got " +
          std::to_string(completion.truncation_angle_deg));
+  }
+  if (!(completion.corner_angle_deg >= 45 && completion.corner_angle_deg < 90)) {
+    Fail("pipeline: completion.corner_angle_deg must be in [45, 90), got " +
+         std::to_string(completion.corner_angle_deg));
   }
   const auto& c = completion;
   if (!(c.face_max_thickness_m >= 0 && c.face_max_aspect >= 0 && c.face_max_aspect <= 1 &&
@@ -261,6 +313,44 @@ class Pipeline::Impl {
     return hidden;
   }
 
+  // Car detections (world frame) lying within a remembered parked car whose box disagrees with
+  // it take the remembered footprint (PipelineParams::parked_prefer_*); @p boxes (vehicle frame)
+  // follow.
+  void PreferRememberedFootprints(const FrameResult& r, std::vector<objects::Box3>* boxes,
+                                  std::vector<objects::Detection>* detections) const {
+    if (params.parked_prefer_fraction > 1.0 || parked.empty()) return;
+    const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
+    const double m = params.parked_footprint_margin_m;
+    for (std::size_t i = 0; i < detections->size(); ++i) {
+      objects::Detection& d = (*detections)[i];
+      if (d.classification.class_index != car_class ||
+          std::any_of(parked.begin(), parked.end(), [&](const auto& entry) {
+            return (entry.second.xy_m - d.xy_m).norm() <= params.parked_prefer_offset_m;
+          })) {
+        continue;
+      }
+      for (const auto& [id, car] : parked) {
+        const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(car.xy_m.x(), car.xy_m.y(), 0.0)).head<2>();
+        const int inside = PointsInsideFootprint(r.cloud, r.blobs[i], xy, car.yaw_rad - r.ego_world.yaw_rad,
+                                                 0.5 * car.length_m + m, 0.5 * car.width_m + m);
+        if (inside < params.parked_prefer_fraction * static_cast<double>(r.blobs[i].size())) continue;
+        objects::Box3& box = (*boxes)[i];
+        const float yaw = static_cast<float>(car.yaw_rad - r.ego_world.yaw_rad);
+        box.center.head<2>() = xy.cast<float>();
+        box.size = Eigen::Vector3f(static_cast<float>(car.length_m), static_cast<float>(car.width_m), box.size.z());
+        box.yaw_rad = yaw;
+        const Eigen::Vector3f up = box.axes.col(2);
+        const Eigen::Vector3f heading(std::cos(yaw), std::sin(yaw), 0.0f);
+        box.axes.col(0) = (heading - up * up.dot(heading)).normalized();
+        box.axes.col(1) = up.cross(box.axes.col(0));
+        const objects::Classification cls = d.classification;
+        d = car;
+        d.classification = cls;
+        break;
+      }
+    }
+  }
+
   // A box as FitVerticalBox gives it, or along its de-noised heading when depth noise dominates.
   objects::Box3 FitBox(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& up,
                        std::optional<float> hint, const Eigen::Vector2f& viewer) const {
@@ -268,7 +358,10 @@ class Pipeline::Impl {
                                                 params.noise_dominated_fraction)) {
       return objects::FitVerticalBoxAtHeading(cloud.xyz, blob, up, *heading, params.box_trim_fraction);
     }
-    return objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction);
+    const objects::Box3 smallest = objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction);
+    if (smallest.size.x() < params.edge_heading_min_length_m) return smallest;
+    return objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction,
+                                   objects::HeadingCriterion::kEdgeCloseness);
   }
 
   // What a box is seen as: on the ground, its class and completed box from the viewer; floating
@@ -387,6 +480,45 @@ class Pipeline::Impl {
     }
   }
 
+  // Splits long blobs seen across their length at a gap when both parts are cars
+  // (PipelineParams::face_pair_*): the ends of two neighbouring parked cars.
+  void SplitFacePairs(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                      std::vector<Seen>* seen) const {
+    if (params.face_pair_min_length_m <= 0.0 || car_class < 0) return;
+    const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
+    const std::size_t n = r.boxes.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const objects::Box3& box = r.boxes[i];
+      if (!(*seen)[i].on_ground || box.size.x() < params.face_pair_min_length_m) continue;
+      const Eigen::Vector2f sight = (box.center.head<2>() - (*viewers)[i]).normalized();
+      if (std::abs(box.axes.col(0).head<2>().dot(sight)) >= kCos45) continue;
+      // Each part at least a car end's narrowest (Atlas width min) less the edge fattening.
+      const auto gap = SparsestStretch(r.cloud, r.blobs[i], box.axes.col(0), 0.5f * static_cast<float>(car.width.min_m),
+                                       params.face_pair_gap_density);
+      if (!gap) continue;
+      std::array<std::vector<int>, 2> parts;
+      for (int p : r.blobs[i]) parts[box.axes.col(0).dot(r.cloud.xyz.col(p)) < *gap ? 0 : 1].push_back(p);
+      objects::Box3 boxes[2];
+      Seen views[2];
+      bool both = true;
+      for (int h = 0; h < 2 && both; ++h) {
+        both = parts[h].size() >= static_cast<std::size_t>(params.segmentation.min_blob_points);
+        if (!both) break;
+        boxes[h] = FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]);
+        views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
+        both = views[h].viewed.classification.class_index == car_class;
+      }
+      if (!both) continue;
+      r.boxes[i] = boxes[0];
+      r.blobs[i] = std::move(parts[0]);
+      (*seen)[i] = views[0];
+      r.boxes.push_back(boxes[1]);
+      r.blobs.push_back(std::move(parts[1]));
+      seen->push_back(views[1]);
+      viewers->push_back((*viewers)[i]);
+    }
+  }
+
   // Splits pedestrian-tall blobs too long for one person (two people walking one behind the
   // other along the sight line) in two along their length, when both halves are pedestrians.
   void SplitTandems(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
@@ -402,6 +534,10 @@ class Pipeline::Impl {
           !ped.height.Contains(box.size.z()) || box.size.y() > ped.width.max_m) {
         continue;
       }
+      // One behind the other means long along the sight line; long across it is a face (a car's
+      // end seen head-on is as tall and thin, and its halves as wide as people).
+      const Eigen::Vector2f sight = box.center.head<2>() - (*viewers)[i];
+      if (std::abs(box.axes.col(0).head<2>().dot(sight.normalized())) < kCos45) continue;
       std::array<std::vector<int>, 2> halves = SplitAlong(r.cloud, r.blobs[i], box.axes.col(0));
       if (halves[0].size() < static_cast<std::size_t>(params.segmentation.min_blob_points) ||
           halves[1].size() < static_cast<std::size_t>(params.segmentation.min_blob_points)) continue;
@@ -498,6 +634,7 @@ std::optional<planning_iface::PerceptionStatus> Pipeline::TakePendingStatus() {
 }
 
 namespace {
+
 RigInput ToInput(const stereo::RigResult& rr, std::int64_t stamp_ns) {
   RigInput in;
   in.rig_id = rr.rig_id;
@@ -644,6 +781,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   std::vector<Pipeline::Impl::Seen> seen;
   for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], up, viewers[i]));
   s.MergeFragments(r, up, &viewers, &seen);
+  s.SplitFacePairs(r, up, &viewers, &seen);
   s.SplitTandems(r, up, &viewers, &seen);
   s.UnclassifyFramedFaces(r, viewers, &seen);
   std::vector<objects::Detection> detections;
@@ -660,6 +798,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     r.box_classes.push_back(s.atlas.classes()[d.classification.class_index].name);
     detections.push_back(d);
   }
+  s.PreferRememberedFootprints(r, &r.boxes, &detections);
   r.status.stages.push_back({"classes", MsSince(t0)});
 
   // Stage: tracks.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -53,6 +54,65 @@ std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth
   return out;
 }
 
+// The angle between two box headings, degrees in 0..90 (a box's front and back look alike).
+double AxisAngleDeg(double a_rad, double b_rad) {
+  double d = std::fmod(std::abs(a_rad - b_rad), kPi);
+  return std::min(d, kPi - d) * 180.0 / kPi;
+}
+
+// A world-frame heading as seen in the frame @p T_to maps into.
+double HeadingIn(const Eigen::Isometry3d& T_to, double yaw_rad) {
+  const Eigen::Vector3d heading = T_to.linear() * Eigen::Vector3d(std::cos(yaw_rad), std::sin(yaw_rad), 0.0);
+  return std::atan2(heading.y(), heading.x());
+}
+
+SceneMiss DescribeMiss(std::int64_t frame, const std::string& cls, int id, const Eigen::Vector2d& at,
+                       double yaw_rad, double visible_fraction, const std::vector<pi::Obstacle>& obstacles) {
+  constexpr double kNearestWithinM = 3.0;
+  SceneMiss miss;
+  miss.frame = frame;
+  miss.class_name = cls;
+  miss.truth_id = id;
+  miss.x_m = at.x();
+  miss.y_m = at.y();
+  miss.visible_fraction = visible_fraction;
+  double best = kNearestWithinM;
+  for (const auto& o : obstacles) {
+    const double d = (o.center_m.head<2>() - at).norm();
+    if (d >= best) continue;
+    best = d;
+    miss.nearest_class = o.class_name;
+    miss.nearest_m = d;
+    miss.nearest_length_m = o.size_m.x();
+    miss.nearest_width_m = o.size_m.y();
+    miss.nearest_points = o.num_points;
+    miss.nearest_yaw_err_deg = AxisAngleDeg(yaw_rad, o.yaw_rad);
+  }
+  return miss;
+}
+
+SceneFalseAlarm DescribeFalseAlarm(std::int64_t frame, const std::string& cls, const pi::Obstacle& d,
+                                   const std::vector<sim::GtBox>& truths, const Eigen::Isometry3d& T_vw) {
+  SceneFalseAlarm alarm;
+  alarm.frame = frame;
+  alarm.class_name = cls;
+  alarm.x_m = d.center_m.x();
+  alarm.y_m = d.center_m.y();
+  alarm.length_m = d.size_m.x();
+  alarm.width_m = d.size_m.y();
+  alarm.points = d.num_points;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& o : truths) {
+    const double dist = ((T_vw * o.center_m).head<2>() - d.center_m.head<2>()).norm();
+    if (dist >= best) continue;
+    best = dist;
+    alarm.nearest_truth_id = o.id;
+    alarm.nearest_truth_class = o.class_name;
+    alarm.nearest_truth_m = dist;
+  }
+  return alarm;
+}
+
 }  // namespace
 
 SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
@@ -81,7 +141,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
     }
   }
   SceneEval out;
-  std::vector<double> center_errors, slot_center, slot_yaw;
+  std::vector<double> center_errors, size_errors, car_yaw_errors, slot_center, slot_yaw;
   objects::IdSwitchCounter switches(params.car_match_m);
   std::vector<double> ade_list, fde_list;
   // Truth positions of pedestrians over time for prediction scoring (world frame).
@@ -102,19 +162,25 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
       std::vector<Eigen::Vector2d> truth, det;
       std::vector<int> truth_id, det_track;
       std::vector<bool> truth_visible;
+      std::vector<double> truth_visible_fraction;
+      std::vector<const sim::GtBox*> truth_box;
+      std::vector<const pi::Obstacle*> det_box;
       for (const auto& o : f.truth->objects) {
         if (o.class_name != cls) continue;
         const Eigen::Vector2d v = (T_vw * o.center_m).head<2>();
         if (v.norm() > params.range_m) continue;
         truth.push_back(v);
         truth_id.push_back(o.id);
-        truth_visible.push_back(calibration && sim::VisibleFraction(o, f.truth->objects, *calibration, T_wv) >=
-                                                   params.min_visible_fraction);
+        truth_box.push_back(&o);
+        const double visible = calibration ? sim::VisibleFraction(o, f.truth->objects, *calibration, T_wv) : 0.0;
+        truth_visible_fraction.push_back(visible);
+        truth_visible.push_back(calibration && visible >= params.min_visible_fraction);
       }
       for (const auto& o : f.obstacles->obstacles) {
         if (o.class_name != cls || o.center_m.head<2>().norm() > params.range_m) continue;
         det.push_back(o.center_m.head<2>());
         det_track.push_back(o.track_id);
+        det_box.push_back(&o);
       }
       const auto m = Match(truth, det, cls == "car" ? params.car_match_m : params.pedestrian_match_m);
       ClassScore& score = cls == "car" ? out.car : out.pedestrian;
@@ -131,8 +197,27 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
         seen.detections += static_cast<std::int64_t>(det.size()) - matched_hidden;
         seen.matched_truths += matched_visible;
         seen.matched_detections += matched_visible;
+        std::vector<bool> matched(truth.size()), used(det.size());
+        for (const auto& [i, j] : m) matched[i] = used[j] = true;
+        for (std::size_t j = 0; j < det.size(); ++j) {
+          if (used[j]) continue;
+          out.false_alarms.push_back(DescribeFalseAlarm(out.frames - 1, cls, *det_box[j], f.truth->objects, T_vw));
+        }
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+          if (matched[i] || !truth_visible[i]) continue;
+          out.misses.push_back(DescribeMiss(out.frames - 1, cls, truth_id[i], truth[i],
+                                            HeadingIn(T_vw, truth_box[i]->yaw_rad), truth_visible_fraction[i],
+                                            f.obstacles->obstacles));
+        }
       }
-      for (const auto& [i, j] : m) center_errors.push_back((truth[i] - det[j]).norm());
+      for (const auto& [i, j] : m) {
+        center_errors.push_back((truth[i] - det[j]).norm());
+        const sim::GtBox& t = *truth_box[i];
+        const pi::Obstacle& d = *det_box[j];
+        size_errors.push_back((t.size_m - d.size_m).norm());
+        // Cars only: a pedestrian's footprint is too square for a heading.
+        if (cls == "car") car_yaw_errors.push_back(AxisAngleDeg(HeadingIn(T_vw, t.yaw_rad), d.yaw_rad));
+      }
       for (std::size_t i = 0; i < truth.size(); ++i) gt_ids.push_back({truth_id[i], truth[i]});
       for (std::size_t j = 0; j < det.size(); ++j) {
         if (det_track[j] >= 0) track_ids.push_back({det_track[j], det[j]});
@@ -196,9 +281,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
         if (found != nullptr && found->feasible) {
           ++out.slot_found_frames;
           slot_center.push_back(best);
-          double dyaw = std::fmod(std::abs(found->target.yaw_rad - bay.yaw_rad), kPi);
-          dyaw = std::min(dyaw, kPi - dyaw);
-          slot_yaw.push_back(dyaw * 180 / kPi);
+          slot_yaw.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
         }
       }
     }
@@ -209,6 +292,8 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   }
   out.visibility_scored = calibration.has_value();
   out.box_center_err_m_median = Median(center_errors);
+  out.box_size_err_m_median = Median(size_errors);
+  out.car_yaw_err_deg_median = Median(car_yaw_errors);
   out.id_switches = switches.score().id_switches;
   out.predictions_scored = static_cast<std::int64_t>(ade_list.size());
   for (double a : ade_list) out.ade_m += a / ade_list.size();
@@ -224,7 +309,8 @@ std::string SceneEval::ToJson() const {
   js << "{\"frames\":" << frames << ", \"car\":{\"precision\":" << car.precision()
      << ", \"recall\":" << car.recall() << "}, \"pedestrian\":{\"precision\":" << pedestrian.precision()
      << ", \"recall\":" << pedestrian.recall() << "}, \"box_center_err_m_median\":" << box_center_err_m_median
-     << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
+     << ", \"box_size_err_m_median\":" << box_size_err_m_median
+     << ", \"car_yaw_err_deg_median\":" << car_yaw_err_deg_median << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
      << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
      << ", \"center_err_m\":" << slot_center_err_m << ", \"yaw_err_deg\":" << slot_yaw_err_deg
      << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}";
@@ -253,12 +339,35 @@ std::string SceneEval::ToText() const {
       << pedestrian_visible.precision() << "  recall " << pedestrian_visible.recall() << "  ("
       << pedestrian_visible.matched_truths << "/" << pedestrian_visible.truths << ")\n";
   }
-  t << "box centre error median: " << box_center_err_m_median << " m   ID switches: " << id_switches << "\n"
+  t << "box errors (median): centre " << box_center_err_m_median << " m, size " << box_size_err_m_median
+    << " m, car yaw " << car_yaw_err_deg_median << " deg   ID switches: " << id_switches << "\n"
     << "pedestrian prediction:  ADE " << ade_m << " m  FDE " << fde_m << " m (" << predictions_scored
     << " predictions scored)\n"
     << "parking slot: found in " << slot_found_frames << "/" << slot_visible_frames
     << " frames where visible, centre error " << slot_center_err_m << " m, yaw error " << slot_yaw_err_deg
     << " deg; narrow bay reported feasible " << narrow_reported_feasible << " times\n";
+  return t.str();
+}
+
+std::string SceneEval::MissesText() const {
+  std::ostringstream t;
+  t.precision(3);
+  for (const SceneMiss& m : misses) {
+    t << "frame " << m.frame << " " << m.class_name << " " << m.truth_id << " at (" << m.x_m << ", " << m.y_m
+      << ") m, " << 100 * m.visible_fraction << "% visible: ";
+    if (m.nearest_class.empty()) {
+      t << "nothing within 3 m\n";
+    } else {
+      t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away, " << m.nearest_length_m << " x "
+        << m.nearest_width_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, " << m.nearest_points
+        << " points\n";
+    }
+  }
+  for (const SceneFalseAlarm& a : false_alarms) {
+    t << "frame " << a.frame << " false " << a.class_name << " at (" << a.x_m << ", " << a.y_m << ") m, "
+      << a.length_m << " x " << a.width_m << " m, " << a.points << " points: nearest truth " << a.nearest_truth_class
+      << " " << a.nearest_truth_id << " " << a.nearest_truth_m << " m away\n";
+  }
   return t.str();
 }
 

@@ -44,6 +44,15 @@ struct Box3 {
 Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
                std::optional<float> hint_yaw_rad = std::nullopt);
 
+/// How FitVerticalBox's heading search (trim_fraction > 0) judges a heading.
+enum class HeadingCriterion {
+  kSmallestArea,  ///< the smallest trimmed footprint rectangle
+  /// The rectangle whose sides the points lie closest to (the closeness criterion of L-shape
+  /// fitting): a car's end face plus the part of its side seen obliquely, smeared by stereo
+  /// noise, has no clearly smallest rectangle but two clear sides.
+  kEdgeCloseness,
+};
+
 /// Vertical cuboid: height along @p up (unit ground normal, e.g. from ground removal), footprint
 /// the minimum-area rectangle of the points projected onto the ground plane (rotating calipers
 /// over the convex hull, exact for partly seen L-shaped car outlines where PCA is biased).
@@ -54,9 +63,11 @@ Box3 FitPcaBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
 /// @param trim_fraction for noisy points (stereo at range): the fraction of points ignored at
 ///        each end of every axis, and the heading is the one whose trimmed footprint rectangle
 ///        is smallest (searched in 1 degree steps) instead of the exact hull's; 0 = exact fit.
+/// @param criterion with trim_fraction > 0: how the searched heading is judged (HeadingCriterion).
 Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices,
                     const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ(),
-                    std::optional<float> hint_yaw_rad = std::nullopt, float trim_fraction = 0.f);
+                    std::optional<float> hint_yaw_rad = std::nullopt, float trim_fraction = 0.f,
+                    HeadingCriterion criterion = HeadingCriterion::kSmallestArea);
 
 /// The same cuboid with its heading given (e.g. estimated with the depth noise taken out): the
 /// footprint's (trimmed) extents along @p yaw_rad and across it; the returned yaw is the

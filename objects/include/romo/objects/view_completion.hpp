@@ -16,6 +16,11 @@ struct ViewCompletionParams {
   /// A footprint axis within this angle of the line of sight has only its near face seen. At 45
   /// degrees (a corner view) both faces are seen whole, so the angle must stay below 45.
   double truncation_angle_deg = 40.0;
+  /// When neither axis is that near the sight line but both are within this angle of it (a
+  /// corner view), each axis in turn is read as the truncated one; 45 = off. Off by default: seen
+  /// at a corner both faces show whole unless something cut one off, which only the scene around
+  /// can tell (in a row of parked cars the neighbour or the field of view often does).
+  double corner_angle_deg = 45.0;
   /// Objects nearer than this to the viewer are not completed (the line of sight is undefined).
   double min_range_m = 0.5;
   /// With a truncated extent, classes scoring within this factor of the best are equally likely

@@ -4,6 +4,7 @@
 /// range of the ego, box centre error, ID switches, prediction ADE/FDE and the parking slot.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace romo::pipeline {
 
@@ -25,6 +26,31 @@ struct ClassScore {
   double recall() const { return truths ? double(matched_truths) / truths : 1.0; }
 };
 
+/// A visible truth no detection of its class matched: what was reported nearest to it instead.
+struct SceneMiss {
+  std::int64_t frame = 0;  ///< index among the scored frames
+  std::string class_name;
+  int truth_id = -1;
+  double x_m = 0.0, y_m = 0.0;  ///< truth centre, vehicle frame
+  double visible_fraction = 0.0;
+  std::string nearest_class;  ///< nearest detection of any class ("" when none within 3 m)
+  double nearest_m = 0.0;
+  double nearest_length_m = 0.0, nearest_width_m = 0.0;
+  double nearest_yaw_err_deg = 0.0;  ///< between the box axes, 0..90
+  int nearest_points = 0;
+};
+
+/// A car or pedestrian detection no truth of its class matched (among visible truths' frames).
+struct SceneFalseAlarm {
+  std::int64_t frame = 0;
+  std::string class_name;
+  double x_m = 0.0, y_m = 0.0, length_m = 0.0, width_m = 0.0;  ///< vehicle frame
+  int points = 0;
+  int nearest_truth_id = -1;  ///< of any class
+  std::string nearest_truth_class;
+  double nearest_truth_m = 0.0;
+};
+
 struct SceneEval {
   std::int64_t frames = 0;
   ClassScore car, pedestrian;  ///< every truth within range
@@ -32,6 +58,8 @@ struct SceneEval {
   ClassScore car_visible, pedestrian_visible;
   bool visibility_scored = false;
   double box_center_err_m_median = 0.0;
+  double box_size_err_m_median = 0.0;   ///< |truth size - box size| (length, width, height)
+  double car_yaw_err_deg_median = 0.0;  ///< between the box axes, 0..90 (cars only)
   std::int64_t id_switches = 0;
   double ade_m = 0.0, fde_m = 0.0;
   std::int64_t predictions_scored = 0;
@@ -39,9 +67,14 @@ struct SceneEval {
   double slot_center_err_m = 0.0;  ///< median over found frames
   double slot_yaw_err_deg = 0.0;   ///< median over found frames
   std::int64_t narrow_reported_feasible = 0;
+  std::vector<SceneMiss> misses;  ///< visible truths missed (only when visibility_scored)
+  std::vector<SceneFalseAlarm> false_alarms;  ///< unmatched detections (only when visibility_scored)
   /// {"frames":N, "car":{...}, ...} exactly as the issue specifies.
   std::string ToJson() const;
   std::string ToText() const;
+  /// One line per miss (frame, class, where, visibility, the nearest detection), then one per
+  /// false alarm (where, size, the nearest truth).
+  std::string MissesText() const;
 };
 
 /// @throws romo::Error when the log cannot be read or holds no ground truth frames.
