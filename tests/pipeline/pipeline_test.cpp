@@ -180,6 +180,65 @@ TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
   EXPECT_TRUE(cars(without[7]).empty()) << "without the memory the track coasts 2 s at most";
 }
 
+// A parked van 6 m long (4..10 m ahead, 1.8 m wide, 1.8 m tall) in the front rig's cloud, the
+// ground under it hidden; @p seen_to_x cuts it (the field of view's edge) at that x.
+RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x) {
+  RigInput in = SyntheticRig(1, stamp_ns);  // ground only
+  in.rig_id = 0;
+  PointCloud kept;
+  for (Eigen::Index i = 0; i < in.cloud.xyz.cols(); ++i) {
+    const Eigen::Vector3f p = in.cloud.xyz.col(i);
+    if (p.x() >= 3.9f && p.x() <= 10.1f && std::abs(p.y()) <= 1.0f) continue;
+    kept.PushBack(p, in.cloud.sigma_z_m[static_cast<std::size_t>(i)], in.cloud.intensity[static_cast<std::size_t>(i)]);
+  }
+  in.cloud = std::move(kept);
+  for (float x = 4.0f; x <= seen_to_x; x += 0.05f) {
+    for (float y = -0.9f; y <= 0.9f; y += 0.05f) in.cloud.PushBack({x, y, 1.8f}, 0.01f, 50.f);
+    for (float z = 0.3f; z <= 1.8f; z += 0.05f) {
+      in.cloud.PushBack({x, -0.9f, z}, 0.01f, 50.f);
+      in.cloud.PushBack({x, 0.9f, z}, 0.01f, 50.f);
+    }
+  }
+  for (float y = -0.9f; y <= 0.9f; y += 0.05f) {
+    for (float z = 0.3f; z <= 1.8f; z += 0.05f) in.cloud.PushBack({4.0f, y, z}, 0.01f, 50.f);
+  }
+  return in;
+}
+
+TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // Seen whole for 4 frames (remembered: centre (7, 0), 6 x 1.8 m along x), then only its first
+  // 2.5 m: completed alone to the Atlas car's mean length, its centre lands 0.8 m short.
+  auto last_car = [&](const PipelineParams& params) {
+    Pipeline pipe(calibration, params);
+    std::int64_t t = 1'000'000'000;
+    for (int k = 0; k < 4; ++k, t += 100'000'000) {
+      pipe.ProcessClouds(t, k, {ParkedVanScene(t, 10.0f)}, std::nullopt, std::nullopt);
+    }
+    const FrameResult r = pipe.ProcessClouds(t, 4, {ParkedVanScene(t, 6.5f)}, std::nullopt, std::nullopt);
+    std::vector<planning_iface::Obstacle> measured;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.class_name == "car" && o.num_points > 0) measured.push_back(o);
+    }
+    return measured;
+  };
+  PipelineParams own_view;
+  own_view.parked_prefer_fraction = 2.0;  // off
+  const auto alone = last_car(own_view);
+  ASSERT_EQ(alone.size(), 1u);
+  const double own_offset = std::hypot(alone[0].center_m.x() - 7.0, alone[0].center_m.y());
+  std::printf("FIGURE partial view of a parked van: own completed box %.2f m off, %.2f x %.2f m\n", own_offset,
+              alone[0].size_m.x(), alone[0].size_m.y());
+  ASSERT_GT(own_offset, 0.5) << "the cut view alone must be boxed off the van for this test";
+
+  const auto preferred = last_car(PipelineParams{});
+  ASSERT_EQ(preferred.size(), 1u);
+  EXPECT_NEAR(preferred[0].center_m.x(), 7.0, kBoxCentreTolM);
+  EXPECT_NEAR(preferred[0].center_m.y(), 0.0, kBoxCentreTolM);
+  EXPECT_NEAR(preferred[0].size_m.x(), 6.0, 2 * kBoxCentreTolM);
+  EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
+}
+
 // Ground, and people 0.45 m square and 1.7 m tall (surface points) at @p xs on the x axis ahead
 // of the front rig.
 RigInput PeopleAhead(const std::vector<float>& xs) {
