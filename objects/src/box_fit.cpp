@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -279,6 +280,7 @@ Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, c
       const float am = 0.5f * (a_lo + a_hi), bm = 0.5f * (b_lo + b_hi);
       best_center = Point2(c * am - s * bm, s * am + c * bm);
     }
+    return area;
   };
   if (fixed_yaw_rad) {
     try_heading(*fixed_yaw_rad, footprint, trim_fraction);
@@ -289,8 +291,23 @@ Box3 FitVertical(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, c
     std::vector<Point2> sample;
     const std::size_t stride = footprint.size() / 1000 + 1;
     for (std::size_t i = 0; i < footprint.size(); i += stride) sample.push_back(footprint[i]);
-    for (int deg = -45; deg < 45; ++deg) try_heading(static_cast<float>(deg) * kPi / 180.f, sample, trim_fraction);
-    const float heading = best_yaw;
+    std::array<float, 90> cost{};
+    for (int deg = -45; deg < 45; ++deg) {
+      cost[static_cast<std::size_t>(deg + 45)] = try_heading(static_cast<float>(deg) * kPi / 180.f, sample, trim_fraction);
+    }
+    float heading = best_yaw;
+    if (criterion == HeadingCriterion::kEdgeCloseness) {
+      // Between the degree steps: the vertex of the parabola through the best step and its two
+      // neighbours (the heading repeats every 90 degrees). The closeness sum is flat near its
+      // peak, and a whole-degree pick jumps between neighbours for a millimetre's change in the
+      // points (the same cloud sent over LCM as int16 mm turned a bay's heading by 3 degrees).
+      const int best = static_cast<int>(std::lround(best_yaw * 180.f / kPi)) + 45;
+      const float before = cost[static_cast<std::size_t>((best + 89) % 90)];
+      const float at = cost[static_cast<std::size_t>(best)];
+      const float after = cost[static_cast<std::size_t>((best + 1) % 90)];
+      const float curvature = before - 2.f * at + after;
+      if (curvature > 0.f) heading += std::clamp(0.5f * (before - after) / curvature, -0.5f, 0.5f) * kPi / 180.f;
+    }
     best_area = 1e30f;
     try_heading(heading, footprint, trim_fraction);
   } else {

@@ -359,7 +359,9 @@ class Pipeline::Impl {
       return objects::FitVerticalBoxAtHeading(cloud.xyz, blob, up, *heading, params.box_trim_fraction);
     }
     const objects::Box3 smallest = objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction);
-    if (smallest.size.x() < params.edge_heading_min_length_m) return smallest;
+    if (params.edge_heading_min_length_m <= 0.0 || smallest.size.x() < params.edge_heading_min_length_m) {
+      return smallest;
+    }
     return objects::FitVerticalBox(cloud.xyz, blob, up, hint, params.box_trim_fraction,
                                    objects::HeadingCriterion::kEdgeCloseness);
   }
