@@ -106,21 +106,24 @@ TEST(PipelineTest, FarCarFrontSplitInTwoIsMergedIntoOneCar) {
   EXPECT_NEAR(car.center_m.y(), 0.0, 0.2);
 }
 
+// Drops the points of @p cloud over x in [x_lo, x_hi], |y| <= 1 m: ground hidden by a parked car.
+void HideGround(PointCloud* cloud, float x_lo, float x_hi) {
+  PointCloud kept;
+  for (Eigen::Index i = 0; i < cloud->xyz.cols(); ++i) {
+    const Eigen::Vector3f p = cloud->xyz.col(i);
+    if (p.x() >= x_lo && p.x() <= x_hi && std::abs(p.y()) <= 1.0f) continue;
+    kept.PushBack(p, cloud->sigma_z_m[static_cast<std::size_t>(i)], cloud->intensity[static_cast<std::size_t>(i)]);
+  }
+  *cloud = std::move(kept);
+}
+
 // The front rig's cloud: ground all round except, while @p ground_under_car is false, under the
 // car-sized footprint 4..8.5 m ahead (hidden by the car, or by something in front of it), and
 // the car itself when @p car_visible.
 RigInput ParkedCarScene(std::int64_t stamp_ns, bool car_visible, bool ground_under_car) {
   RigInput in = SyntheticRig(1, stamp_ns);  // ground only
   in.rig_id = 0;
-  if (!ground_under_car) {
-    PointCloud kept;
-    for (Eigen::Index i = 0; i < in.cloud.xyz.cols(); ++i) {
-      const Eigen::Vector3f p = in.cloud.xyz.col(i);
-      if (p.x() >= 3.9f && p.x() <= 8.6f && std::abs(p.y()) <= 1.0f) continue;
-      kept.PushBack(p, in.cloud.sigma_z_m[static_cast<std::size_t>(i)], in.cloud.intensity[static_cast<std::size_t>(i)]);
-    }
-    in.cloud = std::move(kept);
-  }
+  if (!ground_under_car) HideGround(&in.cloud, 3.9f, 8.6f);
   if (car_visible) {
     const RigInput car = SyntheticRig(0, stamp_ns);
     for (Eigen::Index i = 20000; i < car.cloud.xyz.cols(); ++i) in.cloud.PushBack(car.cloud.xyz.col(i), 0.01f, 50.f);
@@ -185,13 +188,7 @@ TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
 RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x) {
   RigInput in = SyntheticRig(1, stamp_ns);  // ground only
   in.rig_id = 0;
-  PointCloud kept;
-  for (Eigen::Index i = 0; i < in.cloud.xyz.cols(); ++i) {
-    const Eigen::Vector3f p = in.cloud.xyz.col(i);
-    if (p.x() >= 3.9f && p.x() <= 10.1f && std::abs(p.y()) <= 1.0f) continue;
-    kept.PushBack(p, in.cloud.sigma_z_m[static_cast<std::size_t>(i)], in.cloud.intensity[static_cast<std::size_t>(i)]);
-  }
-  in.cloud = std::move(kept);
+  HideGround(&in.cloud, 3.9f, 10.1f);
   for (float x = 4.0f; x <= seen_to_x; x += 0.05f) {
     for (float y = -0.9f; y <= 0.9f; y += 0.05f) in.cloud.PushBack({x, y, 1.8f}, 0.01f, 50.f);
     for (float z = 0.3f; z <= 1.8f; z += 0.05f) {

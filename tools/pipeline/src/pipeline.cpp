@@ -500,25 +500,31 @@ class Pipeline::Impl {
       if (!gap) continue;
       std::array<std::vector<int>, 2> parts;
       for (int p : r.blobs[i]) parts[box.axes.col(0).dot(r.cloud.xyz.col(p)) < *gap ? 0 : 1].push_back(p);
-      objects::Box3 boxes[2];
-      Seen views[2];
-      bool both = true;
-      for (int h = 0; h < 2 && both; ++h) {
-        both = parts[h].size() >= static_cast<std::size_t>(params.segmentation.min_blob_points);
-        if (!both) break;
-        boxes[h] = FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]);
-        views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
-        both = views[h].viewed.classification.class_index == car_class;
-      }
-      if (!both) continue;
-      r.boxes[i] = boxes[0];
-      r.blobs[i] = std::move(parts[0]);
-      (*seen)[i] = views[0];
-      r.boxes.push_back(boxes[1]);
-      r.blobs.push_back(std::move(parts[1]));
-      seen->push_back(views[1]);
-      viewers->push_back((*viewers)[i]);
+      SplitWhenBothAre(car_class, i, std::move(parts), r, up, viewers, seen);
     }
+  }
+
+  // Replaces blob @p i by @p parts when both are blobs (min_blob_points) of class @p class_index
+  // as seen from the blob's camera; the second part is appended.
+  void SplitWhenBothAre(int class_index, std::size_t i, std::array<std::vector<int>, 2> parts, FrameResult& r,
+                        const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                        std::vector<Seen>* seen) const {
+    const auto min_points = static_cast<std::size_t>(params.segmentation.min_blob_points);
+    if (parts[0].size() < min_points || parts[1].size() < min_points) return;
+    objects::Box3 boxes[2];
+    Seen views[2];
+    for (int h = 0; h < 2; ++h) {
+      boxes[h] = FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]);
+      views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
+      if (views[h].viewed.classification.class_index != class_index) return;
+    }
+    r.boxes[i] = boxes[0];
+    r.blobs[i] = std::move(parts[0]);
+    (*seen)[i] = views[0];
+    r.boxes.push_back(boxes[1]);
+    r.blobs.push_back(std::move(parts[1]));
+    seen->push_back(views[1]);
+    viewers->push_back((*viewers)[i]);
   }
 
   // Splits pedestrian-tall blobs too long for one person (two people walking one behind the
@@ -540,25 +546,7 @@ class Pipeline::Impl {
       // end seen head-on is as tall and thin, and its halves as wide as people).
       const Eigen::Vector2f sight = box.center.head<2>() - (*viewers)[i];
       if (std::abs(box.axes.col(0).head<2>().dot(sight.normalized())) < kCos45) continue;
-      std::array<std::vector<int>, 2> halves = SplitAlong(r.cloud, r.blobs[i], box.axes.col(0));
-      if (halves[0].size() < static_cast<std::size_t>(params.segmentation.min_blob_points) ||
-          halves[1].size() < static_cast<std::size_t>(params.segmentation.min_blob_points)) continue;
-      objects::Box3 boxes[2];
-      Seen parts[2];
-      bool both = true;
-      for (int h = 0; h < 2 && both; ++h) {
-        boxes[h] = FitBox(r.cloud, halves[h], up, std::nullopt, (*viewers)[i]);
-        parts[h] = See(r, boxes[h], halves[h], up, (*viewers)[i]);
-        both = parts[h].viewed.classification.class_index == pedestrian_class;
-      }
-      if (!both) continue;
-      r.boxes[i] = boxes[0];
-      r.blobs[i] = std::move(halves[0]);
-      (*seen)[i] = parts[0];
-      r.boxes.push_back(boxes[1]);
-      r.blobs.push_back(std::move(halves[1]));
-      seen->push_back(parts[1]);
-      viewers->push_back((*viewers)[i]);
+      SplitWhenBothAre(pedestrian_class, i, SplitAlong(r.cloud, r.blobs[i], box.axes.col(0)), r, up, viewers, seen);
     }
   }
 
