@@ -238,11 +238,15 @@ TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
 
 // Ground, and people 0.45 m square and 1.7 m tall (surface points) at @p xs on the x axis ahead
 // of the front rig.
-RigInput PeopleAhead(const std::vector<float>& xs) {
+// Ground all round for the front rig, and 0.45 m square people 1.7 m tall standing at @p xs on
+// the x axis, without the points between @p gap_lo_m and @p gap_hi_m above the ground (none by
+// default).
+RigInput PeopleAhead(const std::vector<float>& xs, float gap_lo_m = 0.f, float gap_hi_m = 0.f) {
   RigInput in = SyntheticRig(1, 1000);  // ground only
   in.rig_id = 0;
   for (float cx : xs) {
     for (float z = 0.05f; z <= 1.7f; z += 0.04f) {
+      if (z > gap_lo_m && z < gap_hi_m) continue;
       for (float s = -0.225f; s <= 0.225f; s += 0.03f) {
         in.cloud.PushBack({cx - 0.225f, s, z}, 0.01f, 50.f);
         in.cloud.PushBack({cx + 0.225f, s, z}, 0.01f, 50.f);
@@ -286,6 +290,79 @@ TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {
   const FrameResult single = Pipeline(calibration, PipelineParams{}).ProcessClouds(
       1000, 1, {PeopleAhead({5.f})}, std::nullopt, std::nullopt);
   EXPECT_EQ(pedestrians(single).size(), 1u);
+}
+
+TEST(PipelineTest, ACoastingPersonKeepsAPersonsSizeWhateverItsLastBlobWas) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  Pipeline pipe(calibration, PipelineParams{});
+  std::int64_t t = 1'000'000'000;
+  auto frame = [&](RigInput in, int k) {
+    in.stamp_ns = t;
+    const FrameResult r = pipe.ProcessClouds(t, k, {in}, std::nullopt, std::nullopt);
+    t += 300'000'000;
+    return r;
+  };
+  // A person standing 6.25 m ahead for 4 frames (a confirmed pedestrian track), then, in one
+  // frame, a car-sized blob where they stood (a car drawing up and hiding them, blob and track
+  // taking it), then nothing: the track coasts as a pedestrian, its last blob a car's.
+  for (int k = 0; k < 4; ++k) frame(PeopleAhead({6.25f}), k);
+  const FrameResult car = frame(SyntheticRig(0, 0), 4);
+  ASSERT_EQ(car.obstacles.obstacles.size(), 1u);
+  ASSERT_EQ(car.obstacles.obstacles[0].class_name, "car");
+  const FrameResult hidden = frame(SyntheticRig(1, 0), 5);
+  ASSERT_EQ(hidden.obstacles.obstacles.size(), 1u);
+  const auto& person = hidden.obstacles.obstacles[0];
+  EXPECT_EQ(person.class_name, "pedestrian");
+  EXPECT_EQ(person.num_points, 0);
+  // Not 4.5 x 1.8 m: a person's mean footprint and height from the Atlas.
+  const auto& prior = pipe.atlas().classes()[static_cast<std::size_t>(pipe.atlas().Find("pedestrian"))];
+  EXPECT_DOUBLE_EQ(person.size_m.x(), prior.length.mean_m);
+  EXPECT_DOUBLE_EQ(person.size_m.y(), prior.width.mean_m);
+  EXPECT_DOUBLE_EQ(person.size_m.z(), prior.height.mean_m);
+  EXPECT_NEAR(person.center_m.x(), 6.25, 0.3);
+}
+
+TEST(PipelineTest, APersonBrokenAtTheWaistIsMergedIntoOnePedestrian) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto classes = [](const FrameResult& r) {
+    std::vector<std::string> out;
+    for (const auto& o : r.obstacles.obstacles) out.push_back(o.class_name);
+    return out;
+  };
+  // No points 0.75..1.05 m up (two voxels): legs 0.7 m tall, and a torso floating 1.05 m up.
+  PipelineParams apart;
+  apart.stacked_merge_xy_m = 0.0;
+  const FrameResult two = Pipeline(calibration, apart).ProcessClouds(1000, 1, {PeopleAhead({8.f}, 0.75f, 1.05f)},
+                                                                    std::nullopt, std::nullopt);
+  ASSERT_EQ(two.blobs.size(), 2u) << "the person must come as two pieces for this test";
+  EXPECT_EQ(classes(two), (std::vector<std::string>{"unknown", "unknown"}));
+
+  const FrameResult one = Pipeline(calibration, PipelineParams{}).ProcessClouds(
+      1000, 1, {PeopleAhead({8.f}, 0.75f, 1.05f)}, std::nullopt, std::nullopt);
+  ASSERT_EQ(classes(one), std::vector<std::string>{"pedestrian"});
+  const auto& person = one.obstacles.obstacles[0];
+  EXPECT_NEAR(person.center_m.x(), 8.0, kBoxCentreTolM);
+  EXPECT_NEAR(person.center_m.y(), 0.0, kBoxCentreTolM);
+  // Whole again: within two voxels of the 1.65 m the points span (the trim takes the rest).
+  EXPECT_NEAR(person.size_m.z(), 1.65, 0.3);
+
+  // Pieces that stack to short of their union's class height stay pieces: 1.35 m together, what
+  // a car end's bumper and rear window make. (This one reads as a cyclist end-on, its class
+  // allowed here; a sigma short of the cyclist mean is 1.5 m.)
+  RigInput low = PeopleAhead({8.f}, 0.7f, 0.95f);
+  PointCloud kept;
+  for (Eigen::Index i = 0; i < low.cloud.xyz.cols(); ++i) {
+    if (low.cloud.xyz(2, i) > 1.5f) continue;
+    kept.PushBack(low.cloud.xyz.col(i), low.cloud.sigma_z_m[static_cast<std::size_t>(i)],
+                  low.cloud.intensity[static_cast<std::size_t>(i)]);
+  }
+  low.cloud = std::move(kept);
+  PipelineParams either;
+  either.stacked_merge_classes = {"pedestrian", "cyclist"};
+  const FrameResult short_stack =
+      Pipeline(calibration, either).ProcessClouds(1000, 1, {low}, std::nullopt, std::nullopt);
+  ASSERT_EQ(short_stack.blobs.size(), 2u);
+  EXPECT_EQ(classes(short_stack), (std::vector<std::string>{"unknown", "unknown"}));
 }
 
 // Ground all round for the front rig, and vertical faces 0.05..1.4 m high between the given end
@@ -424,6 +501,9 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.completion.corner_angle_deg = 30.0;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.completion.corner_angle_deg = 50.0;
+  params.stacked_merge_gap_m = -0.1;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.stacked_merge_gap_m = 0.5;
   EXPECT_NO_THROW(params.Validate());
 }
 

@@ -222,6 +222,10 @@ void PipelineParams::Validate() const {
     Fail("pipeline: face_pair_min_length_m must be >= 0 and face_pair_gap_density in (0, 1], got " +
          std::to_string(face_pair_min_length_m) + " m, " + std::to_string(face_pair_gap_density));
   }
+  if (!(stacked_merge_xy_m >= 0 && stacked_merge_gap_m >= 0)) {
+    Fail("pipeline: stacked_merge_xy_m and stacked_merge_gap_m must be >= 0, got " +
+         std::to_string(stacked_merge_xy_m) + " m, " + std::to_string(stacked_merge_gap_m) + " m");
+  }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
   }
@@ -260,6 +264,7 @@ class Pipeline::Impl {
         slots(p.parking),
         stereo(c, StereoParamsOf(p), p.threads) {
     for (const std::string& name : p.fragment_merge_classes) merge_classes.push_back(atlas.Require(name));
+    for (const std::string& name : p.stacked_merge_classes) stacked_classes.push_back(atlas.Require(name));
   }
 
   // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
@@ -385,32 +390,72 @@ class Pipeline::Impl {
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
     return seen;
   }
-  bool Unclassified(const Seen& seen) const {
-    return seen.on_ground && seen.viewed.classification.class_index == atlas.unknown_index();
+  // Whether one of @p a, @p b stands on the ground and the other floats above it, less than
+  // PipelineParams::stacked_merge_gap_m over it (legs and a torso).
+  bool Stacked(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& a, const objects::Box3& b) const {
+    auto bottom = [&](const objects::Box3& box) {
+      return r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
+    };
+    const objects::Box3& lower = bottom(a) <= bottom(b) ? a : b;
+    const objects::Box3& upper = &lower == &a ? b : a;
+    return bottom(lower) <= params.max_ground_gap_m && bottom(upper) > params.max_ground_gap_m &&
+           bottom(upper) - (bottom(lower) + lower.size.z()) <= params.stacked_merge_gap_m;
   }
+  bool OfNoClass(const Seen& seen) const { return seen.viewed.classification.class_index == atlas.unknown_index(); }
+  bool Unclassified(const Seen& seen) const { return seen.on_ground && OfNoClass(seen); }
 
-  // Merges pairs of unclassified neighbouring blobs whose union is a merge class, until none is
-  // left (PipelineParams::fragment_merge_gap_m); @p viewers and @p seen follow the boxes.
+  // Merges pairs of blobs of no class that make a car side by side (PipelineParams::
+  // fragment_merge_*), then pairs that make a person one above the other (stacked_merge_*), until
+  // none is left; @p viewers and @p seen follow the boxes. Cars go first: a car's end broken into
+  // bumper and rear window also stacks into something person-sized.
   void MergeFragments(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
                       std::vector<Seen>* seen) const {
-    if (params.fragment_merge_gap_m <= 0.0) return;
+    auto is_one_of = [](const std::vector<int>& classes, int c) {
+      return std::find(classes.begin(), classes.end(), c) != classes.end();
+    };
+    if (params.fragment_merge_gap_m > 0.0) {
+      MergePairs(r, up, viewers, seen, [&](std::size_t i, std::size_t j) {
+        if (!Unclassified((*seen)[i]) || !Unclassified((*seen)[j])) return false;
+        // Centre distance less both half diagonals: a lower bound of the footprints' gap.
+        const float gap = (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() -
+                          0.5f * (r.boxes[i].size.head<2>().norm() + r.boxes[j].size.head<2>().norm());
+        return gap <= params.fragment_merge_gap_m;
+      }, [&](const objects::Box3&, const Seen& u) {
+        return is_one_of(merge_classes, u.viewed.classification.class_index);
+      });
+    }
+    if (params.stacked_merge_xy_m > 0.0) {
+      // A torso floats above the ground until joined to its legs: of no class, on the ground or not.
+      MergePairs(r, up, viewers, seen, [&](std::size_t i, std::size_t j) {
+        return OfNoClass((*seen)[i]) && OfNoClass((*seen)[j]) &&
+               (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() <= params.stacked_merge_xy_m &&
+               Stacked(r, up, r.boxes[i], r.boxes[j]);
+      }, [&](const objects::Box3& box, const Seen& u) {
+        // Pieces of no class joined are a guess: the stack must stand the class's typical height
+        // (within a sigma of its mean; height is a person's steady extent).
+        const int c = u.viewed.classification.class_index;
+        if (!is_one_of(stacked_classes, c)) return false;
+        const objects::SizePrior& height = atlas.classes()[static_cast<std::size_t>(c)].height;
+        return box.size.z() >= height.mean_m - height.sigma_m;
+      });
+    }
+  }
+
+  // Merges pairs (i, j) of blobs that @p may_merge until none is left whose union, on the ground,
+  // is what @p union_is_one accepts; @p viewers and @p seen follow the boxes.
+  template <typename MayMerge, typename UnionIsOne>
+  void MergePairs(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                  std::vector<Seen>* seen, MayMerge may_merge, UnionIsOne union_is_one) const {
     for (bool merged = true; merged;) {
       merged = false;
       for (std::size_t i = 0; i < r.boxes.size() && !merged; ++i) {
-        for (std::size_t j = i + 1; j < r.boxes.size() && Unclassified((*seen)[i]) && !merged; ++j) {
-          if (!Unclassified((*seen)[j])) continue;
-          // Centre distance less both half diagonals: a lower bound of the footprints' gap.
-          const float gap = (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() -
-                            0.5f * (r.boxes[i].size.head<2>().norm() + r.boxes[j].size.head<2>().norm());
-          if (gap > params.fragment_merge_gap_m) continue;
+        for (std::size_t j = i + 1; j < r.boxes.size() && !merged; ++j) {
+          if (!may_merge(i, j)) continue;
           std::vector<int> blob = r.blobs[i];
           blob.insert(blob.end(), r.blobs[j].begin(), r.blobs[j].end());
           const objects::Box3 box = FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]);
           Seen union_seen = See(r, box, blob, up, (*viewers)[i]);
-          const int c = union_seen.viewed.classification.class_index;
-          if (!union_seen.on_ground || std::find(merge_classes.begin(), merge_classes.end(), c) == merge_classes.end()) {
-            continue;
-          }
+          if (!union_seen.on_ground || !union_is_one(box, union_seen)) continue;
           r.boxes[i] = box;
           r.blobs[i] = std::move(blob);
           (*seen)[i] = std::move(union_seen);
@@ -563,7 +608,8 @@ class Pipeline::Impl {
   drivers::Calibration calibration;
   PipelineParams params;
   objects::Atlas atlas;
-  std::vector<int> merge_classes;  // fragment_merge_classes as atlas indices
+  std::vector<int> merge_classes;    // fragment_merge_classes as atlas indices
+  std::vector<int> stacked_classes;  // stacked_merge_classes as atlas indices
   int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
   int pedestrian_class = atlas.Find("pedestrian");
   std::map<int, objects::Detection> parked;  // world frame, by track id
@@ -864,11 +910,25 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     o.yaw_rad = yaw_world - r.ego_world.yaw_rad;
     return o;
   };
+  // A track not measured alone now (coasting, or one of a blob's several) at its filtered position
+  // with the extents of the last blob it had alone, which need not be its class's: a track voted
+  // a car on earlier views and fed fragments since is still something to avoid, but not a car
+  // where it coasts; a person stays a person however little of them was seen last (planning must
+  // not forget who walked behind a car), of a person's mean size when the last blob was not one.
   auto track_obstacle = [&](const objects::Track& tr, int num_points) {
     planning_iface::Obstacle o = footprint_obstacle(tr.id, tr.class_index, tr.class_score, tr.xy_m, tr.yaw_rad,
                                                     tr.length_m, tr.width_m, tr.height_m);
     o.velocity_mps = Rotate(tr.velocity_mps, -r.ego_world.yaw_rad);
     o.num_points = num_points;
+    const auto& cls = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)];
+    if (cls.has_priors && s.atlas.Score(tr.class_index, tr.length_m, tr.width_m, tr.height_m) < s.atlas.min_score()) {
+      if (cls.predict_path) {
+        o.size_m = Eigen::Vector3d(cls.length.mean_m, cls.width.mean_m, cls.height.mean_m);
+        o.center_m.z() = cls.height.mean_m / 2.0;
+      } else {
+        o.class_name = s.atlas.classes()[static_cast<std::size_t>(s.atlas.unknown_index())].name;
+      }
+    }
     return o;
   };
   for (const auto& tr : r.tracks) {
@@ -879,15 +939,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     } else if (tr.state == objects::TrackState::kLost && tr.class_index >= 0 &&
                tr.class_index != s.atlas.unknown_index() && !s.parked.count(tr.id)) {
       // (a parked car hidden now is listed where it was seen, below, not where its track coasts)
-      planning_iface::Obstacle o = track_obstacle(tr, 0);
-      // A track voted a car on earlier views and fed fragments since keeps a fragment's box: it is
-      // still something to avoid, but not a car where it coasts. A person stays a person however
-      // little of them was seen last: planning must not forget who walked behind a car.
-      const auto& cls = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)];
-      if (!cls.predict_path && s.atlas.Score(tr.class_index, tr.length_m, tr.width_m, tr.height_m) < s.atlas.min_score()) {
-        o.class_name = s.atlas.classes()[static_cast<std::size_t>(s.atlas.unknown_index())].name;
-      }
-      r.obstacles.obstacles.push_back(o);
+      r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
     }
   }
   for (std::size_t i = 0; i < r.boxes.size(); ++i) {

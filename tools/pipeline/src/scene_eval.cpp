@@ -85,6 +85,7 @@ SceneMiss DescribeMiss(std::int64_t frame, const std::string& cls, int id, const
     miss.nearest_m = d;
     miss.nearest_length_m = o.size_m.x();
     miss.nearest_width_m = o.size_m.y();
+    miss.nearest_height_m = o.size_m.z();
     miss.nearest_points = o.num_points;
     miss.nearest_yaw_err_deg = AxisAngleDeg(yaw_rad, o.yaw_rad);
   }
@@ -100,9 +101,18 @@ SceneFalseAlarm DescribeFalseAlarm(std::int64_t frame, const std::string& cls, c
   alarm.y_m = d.center_m.y();
   alarm.length_m = d.size_m.x();
   alarm.width_m = d.size_m.y();
+  alarm.height_m = d.size_m.z();
   alarm.points = d.num_points;
   double best = std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d world = T_vw.inverse() * d.center_m;
   for (const auto& o : truths) {
+    const Eigen::Vector2d offset = (world - o.center_m).head<2>();
+    const double c = std::cos(o.yaw_rad), s = std::sin(o.yaw_rad);
+    if (std::abs(c * offset.x() + s * offset.y()) <= 0.5 * o.size_m.x() &&
+        std::abs(-s * offset.x() + c * offset.y()) <= 0.5 * o.size_m.y()) {
+      alarm.inside_truth_id = o.id;
+      alarm.inside_truth_class = o.class_name;
+    }
     const double dist = ((T_vw * o.center_m).head<2>() - d.center_m.head<2>()).norm();
     if (dist >= best) continue;
     best = dist;
@@ -359,14 +369,17 @@ std::string SceneEval::MissesText() const {
       t << "nothing within 3 m\n";
     } else {
       t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away, " << m.nearest_length_m << " x "
-        << m.nearest_width_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, " << m.nearest_points
-        << " points\n";
+        << m.nearest_width_m << " x " << m.nearest_height_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, "
+        << m.nearest_points << " points\n";
     }
   }
   for (const SceneFalseAlarm& a : false_alarms) {
     t << "frame " << a.frame << " false " << a.class_name << " at (" << a.x_m << ", " << a.y_m << ") m, "
-      << a.length_m << " x " << a.width_m << " m, " << a.points << " points: nearest truth " << a.nearest_truth_class
-      << " " << a.nearest_truth_id << " " << a.nearest_truth_m << " m away\n";
+      << a.length_m << " x " << a.width_m << " x " << a.height_m << " m, " << a.points
+      << " points: nearest truth " << a.nearest_truth_class << " " << a.nearest_truth_id << " " << a.nearest_truth_m
+      << " m away";
+    if (a.inside_truth_id >= 0) t << ", inside " << a.inside_truth_class << " " << a.inside_truth_id;
+    t << "\n";
   }
   return t.str();
 }

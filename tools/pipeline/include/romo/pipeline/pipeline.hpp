@@ -61,10 +61,18 @@ struct PipelineParams {
   double noise_dominated_fraction = 0.5;
   /// Blobs of no class closer than this (footprints' gap, m) whose union is one of
   /// fragment_merge_classes are merged: far car fronts split by depth noise and stereo gaps into
-  /// pieces too narrow for anything. Pedestrians are never formed this way (a person does not
-  /// fragment, and merging would hide a person beside a car's front); 0 turns merging off.
+  /// pieces too narrow for anything. Pedestrians are not formed this way (merging would hide a
+  /// person beside a car's front); 0 turns merging off.
   double fragment_merge_gap_m = 1.0;
   std::vector<std::string> fragment_merge_classes = {"car"};
+  /// Blobs of no class one above the other (footprint centres closer than stacked_merge_xy_m,
+  /// less than stacked_merge_gap_m between them) whose union is one of stacked_merge_classes, no
+  /// more than a sigma short of its mean height, are merged: a person 10-15 m away often breaks at
+  /// the waist, where stereo finds no texture, into legs and a floating torso too short for
+  /// anyone. 0 turns it off.
+  double stacked_merge_xy_m = 0.5;
+  double stacked_merge_gap_m = 0.5;
+  std::vector<std::string> stacked_merge_classes = {"pedestrian"};
   /// A pedestrian-tall blob at least this long (less depth noise) is split in two along its
   /// length when both halves are pedestrians: two people walking one behind the other along the
   /// sight line stay one blob (0.6 m apart on the simulated scene: 56 of 196 pedestrian sightings

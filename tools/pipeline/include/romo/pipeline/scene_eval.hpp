@@ -35,7 +35,7 @@ struct SceneMiss {
   double visible_fraction = 0.0;
   std::string nearest_class;  ///< nearest detection of any class ("" when none within 3 m)
   double nearest_m = 0.0;
-  double nearest_length_m = 0.0, nearest_width_m = 0.0;
+  double nearest_length_m = 0.0, nearest_width_m = 0.0, nearest_height_m = 0.0;
   double nearest_yaw_err_deg = 0.0;  ///< between the box axes, 0..90
   int nearest_points = 0;
 };
@@ -44,11 +44,14 @@ struct SceneMiss {
 struct SceneFalseAlarm {
   std::int64_t frame = 0;
   std::string class_name;
-  double x_m = 0.0, y_m = 0.0, length_m = 0.0, width_m = 0.0;  ///< vehicle frame
+  double x_m = 0.0, y_m = 0.0, length_m = 0.0, width_m = 0.0, height_m = 0.0;  ///< vehicle frame
   int points = 0;
   int nearest_truth_id = -1;  ///< of any class
   std::string nearest_truth_class;
   double nearest_truth_m = 0.0;
+  /// The truth whose footprint holds the detection's centre (a fragment of it), -1 if none.
+  int inside_truth_id = -1;
+  std::string inside_truth_class;
 };
 
 struct SceneEval {
