@@ -494,7 +494,7 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.framed_end_gap_deg = 6.0;
   params.face_pair_gap_density = 0.0;
   EXPECT_THROW(params.Validate(), romo::Error);
-  params.face_pair_gap_density = 0.35;
+  params.face_pair_gap_density = 0.5;
   params.edge_heading_min_length_m = -1.0;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.edge_heading_min_length_m = 1.5;
