@@ -106,15 +106,22 @@ TEST(PipelineTest, FarCarFrontSplitInTwoIsMergedIntoOneCar) {
   EXPECT_NEAR(car.center_m.y(), 0.0, 0.2);
 }
 
-// Drops the points of @p cloud over x in [x_lo, x_hi], |y| <= 1 m: ground hidden by a parked car.
-void HideGround(PointCloud* cloud, float x_lo, float x_hi) {
+// Drops the points of @p cloud that @p drop holds for.
+template <typename Drop>
+void DropPoints(PointCloud* cloud, Drop drop) {
   PointCloud kept;
   for (Eigen::Index i = 0; i < cloud->xyz.cols(); ++i) {
     const Eigen::Vector3f p = cloud->xyz.col(i);
-    if (p.x() >= x_lo && p.x() <= x_hi && std::abs(p.y()) <= 1.0f) continue;
+    if (drop(p)) continue;
     kept.PushBack(p, cloud->sigma_z_m[static_cast<std::size_t>(i)], cloud->intensity[static_cast<std::size_t>(i)]);
   }
   *cloud = std::move(kept);
+}
+
+// Drops the points of @p cloud over x in [x_lo, x_hi], |y| <= 1 m: ground hidden by a parked car.
+void HideGround(PointCloud* cloud, float x_lo, float x_hi) {
+  DropPoints(cloud,
+             [&](const Eigen::Vector3f& p) { return p.x() >= x_lo && p.x() <= x_hi && std::abs(p.y()) <= 1.0f; });
 }
 
 // The front rig's cloud: ground all round except, while @p ground_under_car is false, under the
@@ -236,10 +243,8 @@ TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
   EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
 }
 
-// Ground, and people 0.45 m square and 1.7 m tall (surface points) at @p xs on the x axis ahead
-// of the front rig.
-// Ground all round for the front rig, and 0.45 m square people 1.7 m tall standing at @p xs on
-// the x axis, without the points between @p gap_lo_m and @p gap_hi_m above the ground (none by
+// Ground all round for the front rig, and 0.45 m square people 1.7 m tall (surface points)
+// standing at @p xs on the x axis, without the points between @p gap_lo_m and @p gap_hi_m above the ground (none by
 // default).
 RigInput PeopleAhead(const std::vector<float>& xs, float gap_lo_m = 0.f, float gap_hi_m = 0.f) {
   RigInput in = SyntheticRig(1, 1000);  // ground only
@@ -350,13 +355,7 @@ TEST(PipelineTest, APersonBrokenAtTheWaistIsMergedIntoOnePedestrian) {
   // a car end's bumper and rear window make. (This one reads as a cyclist end-on, its class
   // allowed here; a sigma short of the cyclist mean is 1.5 m.)
   RigInput low = PeopleAhead({8.f}, 0.7f, 0.95f);
-  PointCloud kept;
-  for (Eigen::Index i = 0; i < low.cloud.xyz.cols(); ++i) {
-    if (low.cloud.xyz(2, i) > 1.5f) continue;
-    kept.PushBack(low.cloud.xyz.col(i), low.cloud.sigma_z_m[static_cast<std::size_t>(i)],
-                  low.cloud.intensity[static_cast<std::size_t>(i)]);
-  }
-  low.cloud = std::move(kept);
+  DropPoints(&low.cloud, [](const Eigen::Vector3f& p) { return p.z() > 1.5f; });
   PipelineParams either;
   either.stacked_merge_classes = {"pedestrian", "cyclist"};
   const FrameResult short_stack =

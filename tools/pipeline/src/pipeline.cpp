@@ -384,7 +384,7 @@ class Pipeline::Impl {
     Seen seen;
     seen.viewed.box = box;
     seen.viewed.classification = {atlas.unknown_index(), 1.0};
-    seen.on_ground = r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z())) <= params.max_ground_gap_m;
+    seen.on_ground = BottomHeight(r, up, box) <= params.max_ground_gap_m;
     if (!seen.on_ground) return seen;
     seen.depth_spread_m = DepthSpread(r.cloud.sigma_z_m, blob, params.box_trim_fraction);
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
@@ -393,13 +393,16 @@ class Pipeline::Impl {
   // Whether one of @p a, @p b stands on the ground and the other floats above it, less than
   // PipelineParams::stacked_merge_gap_m over it (legs and a torso).
   bool Stacked(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& a, const objects::Box3& b) const {
-    auto bottom = [&](const objects::Box3& box) {
-      return r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
-    };
-    const objects::Box3& lower = bottom(a) <= bottom(b) ? a : b;
-    const objects::Box3& upper = &lower == &a ? b : a;
-    return bottom(lower) <= params.max_ground_gap_m && bottom(upper) > params.max_ground_gap_m &&
-           bottom(upper) - (bottom(lower) + lower.size.z()) <= params.stacked_merge_gap_m;
+    const float bottom_a = BottomHeight(r, up, a), bottom_b = BottomHeight(r, up, b);
+    const bool a_lower = bottom_a <= bottom_b;
+    const float lower_bottom = a_lower ? bottom_a : bottom_b, upper_bottom = a_lower ? bottom_b : bottom_a;
+    const float lower_height = (a_lower ? a : b).size.z();
+    return lower_bottom <= params.max_ground_gap_m && upper_bottom > params.max_ground_gap_m &&
+           upper_bottom - (lower_bottom + lower_height) <= params.stacked_merge_gap_m;
+  }
+  // How far the bottom of @p box is above the ground plane.
+  static float BottomHeight(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& box) {
+    return r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
   }
   bool OfNoClass(const Seen& seen) const { return seen.viewed.classification.class_index == atlas.unknown_index(); }
   bool Unclassified(const Seen& seen) const { return seen.on_ground && OfNoClass(seen); }

@@ -106,10 +106,8 @@ SceneFalseAlarm DescribeFalseAlarm(std::int64_t frame, const std::string& cls, c
   double best = std::numeric_limits<double>::infinity();
   const Eigen::Vector3d world = T_vw.inverse() * d.center_m;
   for (const auto& o : truths) {
-    const Eigen::Vector2d offset = (world - o.center_m).head<2>();
-    const double c = std::cos(o.yaw_rad), s = std::sin(o.yaw_rad);
-    if (std::abs(c * offset.x() + s * offset.y()) <= 0.5 * o.size_m.x() &&
-        std::abs(-s * offset.x() + c * offset.y()) <= 0.5 * o.size_m.y()) {
+    // The footprint alone: the detection's centre taken at the truth's mid-height.
+    if (o.Contains(Eigen::Vector3d(world.x(), world.y(), o.center_m.z()))) {
       alarm.inside_truth_id = o.id;
       alarm.inside_truth_class = o.class_name;
     }
