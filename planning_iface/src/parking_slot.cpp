@@ -333,9 +333,24 @@ ParkingSlotEstimator::ParkingSlotEstimator(const ParkingParams& params) : params
 
 void ParkingSlotEstimator::Reset() { slots_.clear(); }
 
+void SetDepthEdges(ParkingSlot* slot, double front_m, double rear_m) {
+  ROMO_THROW_UNLESS(slot != nullptr);
+  if (!(std::isfinite(front_m) && std::isfinite(rear_m) && rear_m > front_m)) {
+    std::ostringstream os;
+    os << "parking: slot depth edges front " << front_m << " m, rear " << rear_m
+       << " m (rear must lie beyond front)";
+    Fail(os.str());
+  }
+  slot->target.position_m -= slot->aisle_normal * (0.5 * (front_m + rear_m));
+  slot->depth_m = rear_m - front_m;
+}
+
 std::vector<ParkingSlot> ParkingSlotEstimator::Update(const std::vector<GroundBox>& cars,
-                                                      const Pose2& ego) {
+                                                      const Pose2& ego, const SlotRefiner& refine) {
   std::vector<ParkingSlot> found = FindParkingSlots(cars, ego, params_);
+  if (refine) {
+    for (ParkingSlot& cand : found) refine(cand);
+  }
   std::vector<bool> matched(slots_.size(), false);
   for (auto& cand : found) {
     int best = -1;
@@ -359,11 +374,35 @@ std::vector<ParkingSlot> ParkingSlotEstimator::Update(const std::vector<GroundBo
     }
     ParkingSlot& s = slots_[best];
     const double w = params_.smoothing;
-    s.target.position_m += w * (cand.target.position_m - s.target.position_m);
+    // Along the row the centre is smoothed; across it each edge on its own, so that an edge seen
+    // on the ground is kept when only the neighbours bound it now, and taken at once when first
+    // seen (it is better than any mean with the neighbours').
+    const Eigen::Vector2d u0 = s.row_axis, n0 = s.aisle_normal;
+    double along = s.target.position_m.dot(u0);
+    double front = s.target.position_m.dot(n0) + s.depth_m / 2;  // aisle side
+    double rear = s.target.position_m.dot(n0) - s.depth_m / 2;
+    along += w * (cand.target.position_m.dot(u0) - along);
+    const auto merge_edge = [w](double* edge, bool* from_ground, double measured, bool measured_on_ground) {
+      if (measured_on_ground && !*from_ground) {
+        *edge = measured;
+      } else if (measured_on_ground || !*from_ground) {
+        *edge += w * (measured - *edge);
+      }
+      *from_ground = *from_ground || measured_on_ground;
+    };
+    const double cand_mid = cand.target.position_m.dot(n0);
+    const double cand_half = 0.5 * cand.depth_m;
+    // (seen from the other side of the row, the candidate's front is the tracked slot's rear)
+    const bool same_side = cand.aisle_normal.dot(n0) >= 0;
+    merge_edge(&front, &s.front_from_ground, cand_mid + cand_half,
+               same_side ? cand.front_from_ground : cand.rear_from_ground);
+    merge_edge(&rear, &s.rear_from_ground, cand_mid - cand_half,
+               same_side ? cand.rear_from_ground : cand.front_from_ground);
+    s.target.position_m = u0 * along + n0 * (0.5 * (front + rear));
+    s.depth_m = front - rear;
     s.target.yaw_rad =
         WrapAngle(s.target.yaw_rad + w * AxisDiff(cand.target.yaw_rad, s.target.yaw_rad));
     s.length_m += w * (cand.length_m - s.length_m);
-    s.depth_m += w * (cand.depth_m - s.depth_m);
     // Keep the row axis oriented as before so the neighbours do not swap sides.
     const bool flipped = cand.row_axis.dot(s.row_axis) < 0;
     const Eigen::Vector2d u = flipped ? Eigen::Vector2d(-cand.row_axis) : cand.row_axis;

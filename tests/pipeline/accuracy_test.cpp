@@ -4,9 +4,10 @@
 //
 // One seed's figures move by several sightings with any change to the stack (which blob a track
 // takes, which view a parked car is remembered from); the mean over five scenes is what a change
-// is judged by. Where the targets are met (slot yaw within 3 degrees, the too-narrow bay
-// never reported feasible) they are asserted in every scene. Where they are not yet met (car and
-// pedestrian recall/precision >= 0.95, box centre within 0.2 m, slot centre within 0.15 m; see
+// is judged by. Where the targets are met (slot centre within 0.15 m and yaw within 3
+// degrees, the too-narrow bay never reported feasible) they are asserted in every scene. Where they
+// are not yet met (car and pedestrian recall/precision >= 0.95, box centre within 0.2 m, the bay
+// found in every frame it is fully visible; see
 // README "Accuracy") today's five-seed means are asserted as floors a little below the figures
 // measured, so that a change that loses accuracy fails here instead of passing unnoticed. Each
 // run is deterministic for a build (fixed seed, rendering and matching independent of thread
@@ -72,6 +73,7 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     ASSERT_EQ(e.frames, 40);
     ASSERT_TRUE(e.visibility_scored) << "romo run writes the calibration into its outputs log";
     // Targets met, in every scene.
+    EXPECT_LE(e.slot_center_err_m, 0.15);
     EXPECT_LE(e.slot_yaw_err_deg, 3.0);
     EXPECT_EQ(e.narrow_reported_feasible, 0);
     // Hidden objects (about 40 car and 25 pedestrian sightings a scene) are neither missed nor
@@ -95,7 +97,8 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // Floors: five-seed means measured with stacked pieces merged into people, coasting tracks
   // kept to their class's size and face pairs split at gaps of half density (car P 0.853 R 0.577,
   // visible R 0.642; pedestrian P 0.711 R 0.715, visible R 0.767; centre 0.221 m; car yaw 8.5
-  // deg; slot 158/160 at 0.171 m). Before those (session 8): car P 0.836 R 0.585, pedestrian P
+  // deg; slot 158/160 at 0.171 m, 157/160 at 0.072 m since its depth is read off the painted line
+  // and the kerb). Before those (session 8): car P 0.836 R 0.585, pedestrian P
   // 0.710 R 0.711, centre 0.225 m, car yaw 9.2 deg; before session 8: car P 0.821 R 0.548,
   // pedestrian P 0.686 R 0.713, centre 0.229 m. About 1.5 % (5 of 300 sightings a scene) of margin.
   EXPECT_GE(mean.car_p, 0.835);
@@ -107,7 +110,7 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   EXPECT_LE(mean.centre_m, 0.23);
   EXPECT_LE(mean.car_yaw_deg, 10.0);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 5);
-  EXPECT_LE(mean.slot_centre_m, 0.185);
+  EXPECT_LE(mean.slot_centre_m, 0.09);
 }
 
 }  // namespace

@@ -234,6 +234,51 @@ TEST(ParkingSlotTest, EstimatorKeepsIdSmoothsNoiseAndReplansAsTheEgoMoves) {
   EXPECT_TRUE(slots.empty());
 }
 
+TEST(ParkingSlotTest, DepthEdgesSeenOnTheGroundOutweighTheNeighbours) {
+  // The perpendicular bay of PerpendicularBaysUseTheRowAcrossTheCars: the cars give its depth as
+  // 3.75..8.25 m; the ground shows the painted front line at 3.4 m and the kerb at 8.8 m.
+  const double h = kCarWidth / 2;
+  const std::vector<GroundBox> cars = {Car(0, 0.0, 6.0, kPi / 2), Car(1, 2 * h + 3.6, 6.0, -kPi / 2)};
+  Pose2 ego;
+  ego.position_m = {h + 1.8, -4.0};
+  ego.yaw_rad = kPi / 2;
+  constexpr double kLineY = 3.4, kKerbY = 8.8;
+  // Edges along the depth axis (into the bay, +y here) are measured from the candidate's target.
+  const auto on_ground = [&](ParkingSlot& slot) {
+    SetDepthEdges(&slot, kLineY - slot.target.position_m.y(), kKerbY - slot.target.position_m.y());
+    slot.front_from_ground = slot.rear_from_ground = true;
+  };
+  ParkingSlotEstimator estimator;
+  auto slots = estimator.Update(cars, ego);  // first from the cars alone
+  ASSERT_EQ(slots.size(), 1u);
+  EXPECT_NEAR(slots[0].target.position_m.y(), 6.0, kExactM);
+  EXPECT_FALSE(slots[0].front_from_ground);
+  // Seen on the ground: taken at once, not averaged with the cars' guess.
+  slots = estimator.Update(cars, ego, on_ground);
+  ASSERT_EQ(slots.size(), 1u);
+  EXPECT_NEAR(slots[0].target.position_m.y(), (kLineY + kKerbY) / 2, kExactM);
+  EXPECT_NEAR(slots[0].depth_m, kKerbY - kLineY, kExactM);
+  EXPECT_NEAR(slots[0].target.position_m.x(), h + 1.8, kExactM);
+  EXPECT_TRUE(slots[0].front_from_ground && slots[0].rear_from_ground);
+  // The approach spot keeps its distance from the painted line now.
+  const double half_diagonal = 0.5 * std::hypot(ParkingParams{}.ego_length_m, ParkingParams{}.ego_width_m);
+  EXPECT_NEAR(slots[0].approach.position_m.y(), kLineY - half_diagonal - ParkingParams{}.turn_clearance_m, kExactM);
+  // The lines hidden again (under the ego, say): the cars do not pull the edges back.
+  for (int frame = 0; frame < 5; ++frame) slots = estimator.Update(cars, ego);
+  EXPECT_NEAR(slots[0].target.position_m.y(), (kLineY + kKerbY) / 2, kExactM);
+  EXPECT_NEAR(slots[0].depth_m, kKerbY - kLineY, kExactM);
+  // Only the front seen, 0.1 m off: it is smoothed, the rear stays.
+  const auto front_only = [&](ParkingSlot& slot) {
+    SetDepthEdges(&slot, kLineY + 0.1 - slot.target.position_m.y(), slot.depth_m / 2);
+    slot.front_from_ground = true;
+  };
+  slots = estimator.Update(cars, ego, front_only);
+  const double w = ParkingParams{}.smoothing;
+  EXPECT_NEAR(slots[0].target.position_m.y() - slots[0].depth_m / 2, kLineY + w * 0.1, kExactM);
+  EXPECT_NEAR(slots[0].target.position_m.y() + slots[0].depth_m / 2, kKerbY, kExactM);
+  EXPECT_THROW(SetDepthEdges(&slots[0], 1.0, 1.0), Error);
+}
+
 TEST(ManeuverStageTest, ForwardTurnSidewaysFromPoses) {
   ManeuverStageTracker tracker;
   std::int64_t t = 0;

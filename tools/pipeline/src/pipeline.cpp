@@ -252,6 +252,10 @@ void PipelineParams::Validate() const {
   segmentation.Validate();
   tracker.Validate();
   parking.Validate();
+  bay_edges.Validate();
+  if (!(bay_strip_margin_m >= 0)) {
+    Fail("pipeline: bay_strip_margin_m must be >= 0, got " + std::to_string(bay_strip_margin_m));
+  }
 }
 
 class Pipeline::Impl {
@@ -997,7 +1001,27 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   r.slots.frame_sequence = frame_sequence;
   r.slots.ego_world = r.ego_world;
   r.slots.stage = s.stage.Update(stamp_ns, r.ego_world);
-  r.slots.slots = s.slots.Update(cars, r.ego_world);
+  planning_iface::SlotRefiner bay_edges_on_ground;
+  if (s.params.bay_edges_from_ground) {
+    bay_edges_on_ground = [&](planning_iface::ParkingSlot& slot) {
+      mapping::BayStrip strip;
+      strip.center_m = slot.target.position_m;
+      strip.depth_axis = -slot.aisle_normal;
+      strip.half_width_m = slot.length_m / 2 - s.params.bay_strip_margin_m;
+      strip.front_m = -slot.depth_m / 2;
+      strip.rear_m = slot.depth_m / 2;
+      if (!(strip.half_width_m > 0) || !(strip.rear_m > strip.front_m)) return;
+      const mapping::BayEdges edges =
+          mapping::FindBayEdges(r.cloud, r.ground_indices, r.T_world_vehicle, strip, s.params.bay_edges);
+      const double front = edges.front_m.value_or(strip.front_m);
+      const double rear = edges.rear_m.value_or(strip.rear_m);
+      if (!(rear > front)) return;
+      planning_iface::SetDepthEdges(&slot, front, rear);
+      slot.front_from_ground = edges.front_m.has_value();
+      slot.rear_from_ground = edges.rear_m.has_value();
+    };
+  }
+  r.slots.slots = s.slots.Update(cars, r.ego_world, bay_edges_on_ground);
   r.status.stages.push_back({"parking", MsSince(t0)});
 
   // Status.

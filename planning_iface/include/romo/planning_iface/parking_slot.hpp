@@ -7,6 +7,7 @@
 /// parallel parking and across them for bays side by side; either way the ego's length lies
 /// along the row, so a gap fits when it is longer than the ego plus both end margins.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,6 +68,11 @@ struct ParkingSlot {
   Pose2 target;      ///< where the ego ends: centred in the gap, heading along the row
   double length_m = 0.0;  ///< free length along the row between the neighbours
   double depth_m = 0.0;   ///< extent across the row (front to back of both neighbours)
+  /// Whether the bay's front (aisle side) and rear edges were measured on the ground (painted
+  /// line, kerb: a SlotRefiner) rather than taken from the neighbours' boxes; once measured, an
+  /// edge is no longer moved by the neighbours.
+  bool front_from_ground = false;
+  bool rear_from_ground = false;
   Eigen::Vector2d row_axis = Eigen::Vector2d::UnitX();  ///< unit, from prev to next neighbour
   Eigen::Vector2d aisle_normal = Eigen::Vector2d::UnitY();  ///< unit, from the row to the aisle
   int prev_id = -1;
@@ -100,6 +106,14 @@ void EvaluateSlot(const std::vector<GroundBox>& cars, const Pose2& ego, const Pa
 std::vector<ParkingSlot> FindParkingSlots(const std::vector<GroundBox>& cars, const Pose2& ego,
                                           const ParkingParams& params);
 
+/// Moves the aisle-side (front) and far (rear) edges of @p slot to @p front_m and @p rear_m,
+/// measured from its target into the bay (against aisle_normal); target and depth follow.
+void SetDepthEdges(ParkingSlot* slot, double front_m, double rear_m);
+
+/// Measures a candidate slot's depth edges on something other than its neighbours (SetDepthEdges
+/// and the *_from_ground flags), before it is merged into the tracked slots.
+using SlotRefiner = std::function<void(ParkingSlot& candidate)>;
+
 /// Keeps slots stable over frames: slots live in a fixed frame (world when the vehicle pose is
 /// known), are associated by position, smoothed, given a confidence, and re-planned (approach,
 /// rotation, path, clearance) for the ego's current pose every frame.
@@ -108,7 +122,9 @@ class ParkingSlotEstimator {
   explicit ParkingSlotEstimator(const ParkingParams& params = {});
   /// @param cars parked-car boxes in the fixed frame; @param ego the ego pose in that frame.
   /// @return every tracked slot (seen now or recently), best confidence first.
-  std::vector<ParkingSlot> Update(const std::vector<GroundBox>& cars, const Pose2& ego);
+  /// @param refine when set, applied to every slot found among @p cars before merging.
+  std::vector<ParkingSlot> Update(const std::vector<GroundBox>& cars, const Pose2& ego,
+                                  const SlotRefiner& refine = {});
   const std::vector<ParkingSlot>& slots() const { return slots_; }
   void Reset();
 

@@ -16,6 +16,7 @@
 #include "romo/drivers/calibration.hpp"
 #include "romo/drivers/frames.hpp"
 #include "romo/mapping/fusion.hpp"
+#include "romo/mapping/bay_edges.hpp"
 #include "romo/mapping/ground_removal.hpp"
 #include "romo/mapping/segmentation.hpp"
 #include "romo/objects/box.hpp"
@@ -123,6 +124,12 @@ struct PipelineParams {
   objects::TrackerParams tracker;
   objects::PredictorKind predictor = objects::PredictorKind::kRls;
   planning_iface::ParkingParams parking;
+  /// A bay's depth is read off the ground through the gap (painted front line, kerb:
+  /// mapping::FindBayEdges) on a strip bay_strip_margin_m narrower than the gap at either end
+  /// (the separator lines and the neighbours' sides stay out); false: the neighbours bound it.
+  bool bay_edges_from_ground = true;
+  mapping::BayEdgeParams bay_edges;
+  double bay_strip_margin_m = 0.3;
   std::string atlas_path;  ///< "" = objects::Atlas::DefaultPath()
 
   static mapping::SegmentationParams DefaultSegmentation();
