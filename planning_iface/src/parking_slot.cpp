@@ -409,8 +409,20 @@ std::vector<ParkingSlot> ParkingSlotEstimator::Update(const std::vector<GroundBo
     s.row_axis = (s.row_axis + w * (u - s.row_axis)).normalized();
     const Eigen::Vector2d n = Perp(s.row_axis);
     s.aisle_normal = n.dot(s.aisle_normal) >= 0 ? n : Eigen::Vector2d(-n);
-    s.prev_box = flipped ? cand.next_box : cand.prev_box;
-    s.next_box = flipped ? cand.prev_box : cand.next_box;
+    // The neighbours are smoothed like the gap they bound: clearances checked for a smoothed
+    // target against one frame's noisy boxes came out 0.1-0.2 m short (seed 2, frames 13-15).
+    const auto smooth_box = [w](const GroundBox& tracked, const GroundBox& seen) {
+      const double turn = AxisDiff(seen.yaw_rad, tracked.yaw_rad);
+      if (FootprintDistance(tracked, seen) > 0.0 || std::abs(turn) > kPi / 4) return seen;  // another car, or refitted
+      GroundBox b = seen;
+      b.center_m = tracked.center_m + w * (seen.center_m - tracked.center_m);
+      b.yaw_rad = WrapAngle(tracked.yaw_rad + w * turn);
+      b.length_m = tracked.length_m + w * (seen.length_m - tracked.length_m);
+      b.width_m = tracked.width_m + w * (seen.width_m - tracked.width_m);
+      return b;
+    };
+    s.prev_box = smooth_box(s.prev_box, flipped ? cand.next_box : cand.prev_box);
+    s.next_box = smooth_box(s.next_box, flipped ? cand.prev_box : cand.next_box);
     s.prev_id = s.prev_box.id;
     s.next_id = s.next_box.id;
     ++s.seen_frames;

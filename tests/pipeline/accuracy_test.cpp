@@ -97,19 +97,20 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // Floors: five-seed means measured with stacked pieces merged into people, coasting tracks
   // kept to their class's size and face pairs split at gaps of half density (car P 0.853 R 0.577,
   // visible R 0.642; pedestrian P 0.711 R 0.715, visible R 0.767; centre 0.221 m; car yaw 8.5
-  // deg; slot 158/160 at 0.171 m, 157/160 at 0.072 m since its depth is read off the painted line
-  // and the kerb). Before those (session 8): car P 0.836 R 0.585, pedestrian P
+  // deg; slot 158/160 at 0.171 m, 160/160 at 0.072 m since its depth is read off the painted line
+  // and the kerb, and the neighbours' boxes are smoothed; pedestrian P 0.731 since tracks coasting
+  // faster than their class moves are not listed). Before those (session 8): car P 0.836 R 0.585, pedestrian P
   // 0.710 R 0.711, centre 0.225 m, car yaw 9.2 deg; before session 8: car P 0.821 R 0.548,
   // pedestrian P 0.686 R 0.713, centre 0.229 m. About 1.5 % (5 of 300 sightings a scene) of margin.
   EXPECT_GE(mean.car_p, 0.835);
   EXPECT_GE(mean.car_r, 0.565);
   EXPECT_GE(mean.car_visible_r, 0.63);
-  EXPECT_GE(mean.ped_p, 0.70);
+  EXPECT_GE(mean.ped_p, 0.715);
   EXPECT_GE(mean.ped_r, 0.70);
   EXPECT_GE(mean.ped_visible_r, 0.755);
   EXPECT_LE(mean.centre_m, 0.23);
   EXPECT_LE(mean.car_yaw_deg, 10.0);
-  EXPECT_GE(mean.slot_found, mean.slot_visible - 5);
+  EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
 }
 

@@ -327,6 +327,38 @@ TEST(PipelineTest, ACoastingPersonKeepsAPersonsSizeWhateverItsLastBlobWas) {
   EXPECT_NEAR(person.center_m.x(), 6.25, 0.3);
 }
 
+TEST(PipelineTest, APersonCoastsAtAWalkButNotFasterThanAPersonMoves) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // A person seen in 6 frames 0.3 s apart moving away at @p speed, then hidden: what is listed.
+  const auto hidden_after = [&](float speed_mps) {
+    Pipeline pipe(calibration, PipelineParams{});
+    std::int64_t t = 1'000'000'000;
+    FrameResult r;
+    for (int k = 0; k < 7; ++k) {
+      RigInput in = k < 6 ? PeopleAhead({5.f + speed_mps * 0.3f * static_cast<float>(k)}) : SyntheticRig(1, 0);
+      in.stamp_ns = t;
+      r = pipe.ProcessClouds(t, k, {in}, std::nullopt, std::nullopt);
+      t += 300'000'000;
+    }
+    return r;
+  };
+  // Walking (1.2 m/s): the hidden person is still listed, ahead of where they were last seen.
+  const FrameResult walking = hidden_after(1.2f);
+  ASSERT_EQ(walking.obstacles.obstacles.size(), 1u);
+  EXPECT_EQ(walking.obstacles.obstacles[0].class_name, "pedestrian");
+  EXPECT_EQ(walking.obstacles.obstacles[0].num_points, 0);
+  EXPECT_GT(walking.obstacles.obstacles[0].center_m.x(), 5.0 + 1.2 * 0.3 * 5);
+  // 5 m/s, beyond the Atlas's 3 m/s for a pedestrian: while seen it is tracked and listed, hidden
+  // it is not coasted on.
+  const FrameResult racing = hidden_after(5.f);
+  bool tracked_fast = false;
+  for (const auto& tr : racing.tracks) {
+    tracked_fast = tracked_fast || (tr.state == objects::TrackState::kLost && tr.velocity_mps.norm() > 3.0);
+  }
+  ASSERT_TRUE(tracked_fast) << "the test needs a coasting track faster than a person";
+  EXPECT_TRUE(racing.obstacles.obstacles.empty());
+}
+
 TEST(PipelineTest, APersonBrokenAtTheWaistIsMergedIntoOnePedestrian) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   auto classes = [](const FrameResult& r) {

@@ -234,6 +234,31 @@ TEST(ParkingSlotTest, EstimatorKeepsIdSmoothsNoiseAndReplansAsTheEgoMoves) {
   EXPECT_TRUE(slots.empty());
 }
 
+TEST(ParkingSlotTest, NeighboursAreSmoothedLikeTheGapTheyBound) {
+  // A perpendicular bay 3.3 m wide (the ego needs 3.2 m): 0.25 m to either neighbour once parked.
+  const double h = kCarWidth / 2, gap = 3.3;
+  const auto row = [&](double next_shift) {
+    return std::vector<GroundBox>{Car(0, -h, 6.0, kPi / 2), Car(1, gap + h + next_shift, 6.0, -kPi / 2)};
+  };
+  Pose2 ego;
+  ego.position_m = {gap / 2, -4.0};
+  ego.yaw_rad = kPi / 2;
+  ParkingSlotEstimator estimator;
+  for (int frame = 0; frame < 5; ++frame) estimator.Update(row(0.0), ego);
+  // One frame's box of the right neighbour 0.15 m into the gap: the smoothed target moves by
+  // 0.4 x 0.075 m, the neighbour by 0.4 x 0.15 m, and the plan keeps its clearance (against that
+  // one frame's box it would be 3.15 - (1.62 + 1.4) = 0.13 m, below the 0.15 m required).
+  const auto slots = estimator.Update(row(-0.15), ego);
+  ASSERT_EQ(slots.size(), 1u);
+  const double w = ParkingParams{}.smoothing;
+  const double target_x = gap / 2 + w * (-0.075);
+  EXPECT_NEAR(slots[0].target.position_m.x(), target_x, kExactM);
+  EXPECT_NEAR(slots[0].next_box.center_m.x(), gap + h - w * 0.15, kExactM);
+  EXPECT_NEAR(slots[0].clearance_prev_m, target_x - 1.4, kExactM);
+  EXPECT_NEAR(slots[0].clearance_next_m, gap - w * 0.15 - (target_x + 1.4), kExactM);
+  EXPECT_TRUE(slots[0].feasible) << slots[0].reason;
+}
+
 TEST(ParkingSlotTest, DepthEdgesSeenOnTheGroundOutweighTheNeighbours) {
   // The perpendicular bay of PerpendicularBaysUseTheRowAcrossTheCars: the cars give its depth as
   // 3.75..8.25 m; the ground shows the painted front line at 3.4 m and the kerb at 8.8 m.

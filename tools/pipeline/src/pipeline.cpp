@@ -946,6 +946,12 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     } else if (tr.state == objects::TrackState::kLost && tr.class_index >= 0 &&
                tr.class_index != s.atlas.unknown_index() && !s.parked.count(tr.id)) {
       // (a parked car hidden now is listed where it was seen, below, not where its track coasts)
+      // A track coasting faster than its class moves (Atlas max_speed_mps) took its velocity from
+      // jumps between unrelated blobs (car-end pieces read as a person): where it coasts to means
+      // nothing.
+      if (tr.velocity_mps.norm() > s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].max_speed_mps) {
+        continue;
+      }
       r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
     }
   }
