@@ -486,6 +486,18 @@ TEST(PipelineTest, TheEndsOfTwoNeighbouringCarsBridgedByStereoAreTwoCars) {
     EXPECT_NEAR(two[k].center_m.x(), 10.0 + car_length / 2, 0.4);
     EXPECT_NEAR(two[k].size_m.y(), 1.8, 0.4);
   }
+
+  // A stretch of the right end's face sparser than the bridge (one row of matches over 0.35 m, a
+  // dark panel) 0.65 m in from its outer edge: split there, the outer part is no car; the
+  // bridge is tried next.
+  RigInput holed = scene();
+  DropPoints(&holed.cloud, [](const Eigen::Vector3f& p) {
+    return p.x() > 9.f && p.y() > -1.55f && p.y() < -1.2f && std::abs(p.z() - 0.71f) > 0.02f;
+  });
+  const std::vector<planning_iface::Obstacle> still_two =
+      cars(Pipeline(calibration, PipelineParams{}).ProcessClouds(1000, 1, {holed}, std::nullopt, std::nullopt));
+  ASSERT_EQ(still_two.size(), 2u);
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(still_two[k].center_m.y(), k == 0 ? -1.3 : 1.3, 0.3);
 }
 
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {

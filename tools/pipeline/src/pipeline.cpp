@@ -113,11 +113,11 @@ std::array<std::vector<int>, 2> SplitAlong(const PointCloud& cloud, const std::v
   return halves;
 }
 
-// Where along @p axis the points of @p blob are sparsest, at least @p margin_m inside both ends,
-// when that stretch (0.1 m bins, averaged over 0.3 m) holds less than @p max_density of the
-// blob's median bin; nothing otherwise.
-std::optional<float> SparsestStretch(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& axis,
-                                     float margin_m, double max_density) {
+// Where along @p axis the points of @p blob thin out, at least @p margin_m inside both ends: the
+// middles of the stretches (0.1 m bins, averaged over 0.3 m) holding less than @p max_density of
+// the blob's median bin, sparsest first, one per stretch.
+std::vector<float> SparseStretches(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& axis,
+                                   float margin_m, double max_density) {
   constexpr float kBinM = 0.1f;
   std::vector<float> along;
   along.reserve(blob.size());
@@ -126,23 +126,28 @@ std::optional<float> SparsestStretch(const PointCloud& cloud, const std::vector<
   const float lo = *lo_it;
   const int bins = static_cast<int>((*hi_it - lo) / kBinM) + 1;
   const int margin_bins = static_cast<int>(margin_m / kBinM);
-  if (bins < 2 * margin_bins + 3) return std::nullopt;
+  if (bins < 2 * margin_bins + 3) return {};
   std::vector<int> count(static_cast<std::size_t>(bins), 0);
   for (float v : along) ++count[static_cast<std::size_t>((v - lo) / kBinM)];
   std::vector<int> sorted = count;
   std::nth_element(sorted.begin(), sorted.begin() + bins / 2, sorted.end());
-  const double median = sorted[static_cast<std::size_t>(bins / 2)];
-  int best = -1;
-  double best_density = max_density * median;
+  const double limit = max_density * sorted[static_cast<std::size_t>(bins / 2)];
+  std::vector<std::pair<double, int>> sparsest;  // (density, bin) of each stretch's sparsest bin
+  bool in_stretch = false;
   for (int b = margin_bins; b < bins - margin_bins; ++b) {
     const double density = (count[b - 1] + count[b] + count[b + 1]) / 3.0;
-    if (density < best_density) {
-      best_density = density;
-      best = b;
+    if (density >= limit) {
+      in_stretch = false;
+      continue;
     }
+    if (!in_stretch) sparsest.emplace_back(density, b);
+    if (density < sparsest.back().first) sparsest.back() = {density, b};
+    in_stretch = true;
   }
-  if (best < 0) return std::nullopt;
-  return lo + (static_cast<float>(best) + 0.5f) * kBinM;
+  std::sort(sparsest.begin(), sparsest.end());
+  std::vector<float> out;
+  for (const auto& [density, b] : sparsest) out.push_back(lo + (static_cast<float>(b) + 0.5f) * kBinM);
+  return out;
 }
 
 }  // namespace
@@ -547,28 +552,32 @@ class Pipeline::Impl {
       const Eigen::Vector2f sight = (box.center.head<2>() - (*viewers)[i]).normalized();
       if (std::abs(box.axes.col(0).head<2>().dot(sight)) >= kCos45) continue;
       // Each part at least a car end's narrowest (Atlas width min) less the edge fattening.
-      const auto gap = SparsestStretch(r.cloud, r.blobs[i], box.axes.col(0), 0.5f * static_cast<float>(car.width.min_m),
-                                       params.face_pair_gap_density);
-      if (!gap) continue;
-      std::array<std::vector<int>, 2> parts;
-      for (int p : r.blobs[i]) parts[box.axes.col(0).dot(r.cloud.xyz.col(p)) < *gap ? 0 : 1].push_back(p);
-      SplitWhenBothAre(car_class, i, std::move(parts), r, up, viewers, seen);
+      // The sparsest stretch can be a thin end (a corner seen obliquely): the next is tried when
+      // its parts are not both cars.
+      const std::vector<float> gaps = SparseStretches(
+          r.cloud, r.blobs[i], box.axes.col(0), 0.5f * static_cast<float>(car.width.min_m), params.face_pair_gap_density);
+      const objects::Box3 whole = box;  // (r.boxes grows on a split)
+      for (float gap : gaps) {
+        std::array<std::vector<int>, 2> parts;
+        for (int p : r.blobs[i]) parts[whole.axes.col(0).dot(r.cloud.xyz.col(p)) < gap ? 0 : 1].push_back(p);
+        if (SplitWhenBothAre(car_class, i, std::move(parts), r, up, viewers, seen)) break;
+      }
     }
   }
 
   // Replaces blob @p i by @p parts when both are blobs (min_blob_points) of class @p class_index
-  // as seen from the blob's camera; the second part is appended.
-  void SplitWhenBothAre(int class_index, std::size_t i, std::array<std::vector<int>, 2> parts, FrameResult& r,
+  // as seen from the blob's camera; the second part is appended. Whether it did.
+  bool SplitWhenBothAre(int class_index, std::size_t i, std::array<std::vector<int>, 2> parts, FrameResult& r,
                         const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
                         std::vector<Seen>* seen) const {
     const auto min_points = static_cast<std::size_t>(params.segmentation.min_blob_points);
-    if (parts[0].size() < min_points || parts[1].size() < min_points) return;
+    if (parts[0].size() < min_points || parts[1].size() < min_points) return false;
     objects::Box3 boxes[2];
     Seen views[2];
     for (int h = 0; h < 2; ++h) {
       boxes[h] = FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]);
       views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
-      if (views[h].viewed.classification.class_index != class_index) return;
+      if (views[h].viewed.classification.class_index != class_index) return false;
     }
     r.boxes[i] = boxes[0];
     r.blobs[i] = std::move(parts[0]);
@@ -577,6 +586,7 @@ class Pipeline::Impl {
     r.blobs.push_back(std::move(parts[1]));
     seen->push_back(views[1]);
     viewers->push_back((*viewers)[i]);
+    return true;
   }
 
   // Splits pedestrian-tall blobs too long for one person (two people walking one behind the

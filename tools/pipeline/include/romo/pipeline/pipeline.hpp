@@ -80,8 +80,8 @@ struct PipelineParams {
   /// lost). 0.9 m is longer than one person's stride (Atlas pedestrian mean + 1.2 sigma). 0 = off.
   double tandem_min_length_m = 0.9;
   /// A blob at least this long seen across its length (the sight line nearer its width than its
-  /// length) is split at the emptiest stretch inside it when that stretch holds less than
-  /// face_pair_gap_density of the blob's median points per length and both parts are cars: the
+  /// length) is split at the emptiest stretch inside it (or the next emptiest, and so on) holding
+  /// less than face_pair_gap_density of the blob's median points per length where both parts are cars: the
   /// ends of two cars parked side by side, 0.6 to 1 m apart, bridged by stereo edge fattening, read
   /// as one car seen side-on and boxed across both (its centre a metre off each). 3.0 m is longer
   /// than any car end (Atlas width max 2.6 m); 0 turns the split off. The gap of two car ends
