@@ -14,6 +14,7 @@
 // count); the margins cover compiler and library differences in floating point.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -70,6 +71,11 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
                 e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
                 static_cast<long long>(e.pedestrian_visible.matched_truths),
                 static_cast<long long>(e.pedestrian_visible.truths));
+    std::printf("FIGURE accuracy seed %d: box centre median cars %.3f m, pedestrians %.3f m\n", seed,
+                e.car.center_err_m_median, e.pedestrian.center_err_m_median);
+    // The median of all matched boxes lies between the two classes' medians.
+    EXPECT_GE(e.box_center_err_m_median, std::min(e.car.center_err_m_median, e.pedestrian.center_err_m_median));
+    EXPECT_LE(e.box_center_err_m_median, std::max(e.car.center_err_m_median, e.pedestrian.center_err_m_median));
     ASSERT_EQ(e.frames, 40);
     ASSERT_TRUE(e.visibility_scored) << "romo run writes the calibration into its outputs log";
     // Targets met, in every scene.

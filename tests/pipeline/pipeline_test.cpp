@@ -558,7 +558,7 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   }
   const std::string eval = romo::test::ReadFile(dir / "eval.json");
-  for (const char* key : {"\"frames\":2", "\"car\"", "\"pedestrian\"", "\"box_center_err_m_median\"",
+  for (const char* key : {"\"frames\":2", "\"car\"", "\"pedestrian\"", "\"center_err_m_median\"", "\"box_center_err_m_median\"",
                           "\"box_size_err_m_median\"", "\"car_yaw_err_deg_median\"", "\"id_switches\"", "\"prediction\"", "\"slot\"", "\"narrow_reported_feasible\""}) {
     EXPECT_NE(eval.find(key), std::string::npos) << key << " in " << eval;
   }

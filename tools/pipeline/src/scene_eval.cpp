@@ -150,6 +150,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   }
   SceneEval out;
   std::vector<double> center_errors, size_errors, car_yaw_errors, slot_center, slot_yaw;
+  std::vector<double> car_center_errors, pedestrian_center_errors;
   objects::IdSwitchCounter switches(params.car_match_m);
   std::vector<double> ade_list, fde_list;
   // Truth positions of pedestrians over time for prediction scoring (world frame).
@@ -220,6 +221,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
       }
       for (const auto& [i, j] : m) {
         center_errors.push_back((truth[i] - det[j]).norm());
+        (cls == "car" ? car_center_errors : pedestrian_center_errors).push_back(center_errors.back());
         const sim::GtBox& t = *truth_box[i];
         const pi::Obstacle& d = *det_box[j];
         size_errors.push_back((t.size_m - d.size_m).norm());
@@ -300,6 +302,8 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   }
   out.visibility_scored = calibration.has_value();
   out.box_center_err_m_median = Median(center_errors);
+  out.car.center_err_m_median = Median(car_center_errors);
+  out.pedestrian.center_err_m_median = Median(pedestrian_center_errors);
   out.box_size_err_m_median = Median(size_errors);
   out.car_yaw_err_deg_median = Median(car_yaw_errors);
   out.id_switches = switches.score().id_switches;
@@ -315,8 +319,10 @@ std::string SceneEval::ToJson() const {
   std::ostringstream js;
   js.precision(4);
   js << "{\"frames\":" << frames << ", \"car\":{\"precision\":" << car.precision()
-     << ", \"recall\":" << car.recall() << "}, \"pedestrian\":{\"precision\":" << pedestrian.precision()
-     << ", \"recall\":" << pedestrian.recall() << "}, \"box_center_err_m_median\":" << box_center_err_m_median
+     << ", \"recall\":" << car.recall() << ", \"center_err_m_median\":" << car.center_err_m_median
+     << "}, \"pedestrian\":{\"precision\":" << pedestrian.precision() << ", \"recall\":" << pedestrian.recall()
+     << ", \"center_err_m_median\":" << pedestrian.center_err_m_median
+     << "}, \"box_center_err_m_median\":" << box_center_err_m_median
      << ", \"box_size_err_m_median\":" << box_size_err_m_median
      << ", \"car_yaw_err_deg_median\":" << car_yaw_err_deg_median << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
      << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
@@ -347,7 +353,8 @@ std::string SceneEval::ToText() const {
       << pedestrian_visible.precision() << "  recall " << pedestrian_visible.recall() << "  ("
       << pedestrian_visible.matched_truths << "/" << pedestrian_visible.truths << ")\n";
   }
-  t << "box errors (median): centre " << box_center_err_m_median << " m, size " << box_size_err_m_median
+  t << "box errors (median): centre " << box_center_err_m_median << " m (cars " << car.center_err_m_median
+    << ", pedestrians " << pedestrian.center_err_m_median << "), size " << box_size_err_m_median
     << " m, car yaw " << car_yaw_err_deg_median << " deg   ID switches: " << id_switches << "\n"
     << "pedestrian prediction:  ADE " << ade_m << " m  FDE " << fde_m << " m (" << predictions_scored
     << " predictions scored)\n"

@@ -22,6 +22,7 @@ struct SceneEvalParams {
 
 struct ClassScore {
   std::int64_t truths = 0, detections = 0, matched_truths = 0, matched_detections = 0;
+  double center_err_m_median = 0.0;  ///< of the matched boxes (car and pedestrian only)
   double precision() const { return detections ? double(matched_detections) / detections : 1.0; }
   double recall() const { return truths ? double(matched_truths) / truths : 1.0; }
 };
