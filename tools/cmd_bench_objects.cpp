@@ -14,6 +14,7 @@
 #include "cli/command_registry.hpp"
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/objects/atlas.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo/objects/tracker.hpp"
@@ -29,11 +30,6 @@ struct Options {
 
 using Clock = std::chrono::steady_clock;
 double Us(Clock::duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 // N pedestrians on a 3 m grid walking in random directions at 0.8-1.6 m/s with 5 cm jitter,
 // 10 Hz. Returns the per-frame Update() times in microseconds (after 5 warm-up frames).

@@ -18,6 +18,7 @@
 #include "cli/command_registry.hpp"
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/drivers/calibration.hpp"
 #include "romo/stereo/multi_rig.hpp"
 #include "romo/stereo/sgm.hpp"
@@ -32,11 +33,6 @@ struct Options {
   std::string calib;
   bool json = false;
 };
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 double TimeMs(const std::function<void()>& run) {
   const auto t0 = std::chrono::steady_clock::now();

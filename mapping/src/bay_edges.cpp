@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 
 namespace romo::mapping {
 namespace {
@@ -14,14 +15,6 @@ struct Sample {
   double s;  // along the depth axis
   float intensity;
 };
-
-double Percentile(std::vector<double> v, double q) {
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-double Median(std::vector<double> v) { return Percentile(std::move(v), 0.5); }
 
 // Positions along the depth axis of the samples in bins [first, last] passing @p keep.
 template <typename Keep>

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/drivers/recording.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo/objects/tracking_eval.hpp"
@@ -19,12 +20,6 @@ namespace pi = planning_iface;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 struct Frame {
   std::optional<sim::GroundTruth> truth;
