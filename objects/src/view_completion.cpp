@@ -1,6 +1,8 @@
 #include "romo/objects/view_completion.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 #include <sstream>
@@ -95,9 +97,10 @@ std::vector<Reading> Readings(const Footprint& f, const ViewCompletionParams& pa
   return readings;
 }
 
-// Every class with priors under every reading when @p only_class < 0, else only that class.
+// Every class with priors under every reading when @p only_class < 0, else only that class; with
+// @p only_length_axis >= 0 only with that footprint axis as the length.
 std::vector<Candidate> Candidates(const Atlas& atlas, double height_m, const std::vector<Reading>& readings,
-                                  const ViewCompletionParams& params, int only_class) {
+                                  const ViewCompletionParams& params, int only_class, int only_length_axis) {
   std::vector<Candidate> candidates;
   for (std::size_t c = 0; c < atlas.classes().size(); ++c) {
     const ObjectClass& cls = atlas.classes()[c];
@@ -106,6 +109,7 @@ std::vector<Candidate> Candidates(const Atlas& atlas, double height_m, const std
     if (h < 0) continue;
     for (const Reading& r : readings) {
       for (int length_axis = 0; length_axis < 2; ++length_axis) {
+        if (only_length_axis >= 0 && length_axis != only_length_axis) continue;
         const int width_axis = 1 - length_axis;
         const double l = ExtentCost(cls.length, r.extent[length_axis], r.truncated_axis == length_axis);
         const double w = ExtentCost(cls.width, r.extent[width_axis], r.truncated_axis == width_axis);
@@ -170,7 +174,8 @@ Box3 Completed(const Box3& box, const Footprint& f, const Reading& r, double com
 
 // Every class with priors competes when @p only_class < 0, else only that one.
 ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& viewer_xy,
-                   const ViewCompletionParams& params, double depth_spread_m, int only_class) {
+                   const ViewCompletionParams& params, double depth_spread_m, int only_class,
+                   std::optional<double> length_heading_rad = std::nullopt) {
   if (!(depth_spread_m >= 0.0) || !std::isfinite(depth_spread_m)) {
     Fail("ClassifyFromViewpoint: depth_spread_m must be finite and >= 0, got " + std::to_string(depth_spread_m));
   }
@@ -190,8 +195,19 @@ ViewedBox Classify(const Atlas& atlas, const Box3& box, const Eigen::Vector2f& v
   const Eigen::Vector2d sight = f.center - viewer_xy.cast<double>();
   if (sight.norm() >= params.min_range_m) f.sight = sight.normalized();
 
-  const std::vector<Reading> readings = Readings(f, params, depth_spread_m);
-  const std::vector<Candidate> candidates = Candidates(atlas, box.size.z(), readings, params, only_class);
+  std::vector<Reading> readings = Readings(f, params, depth_spread_m);
+  int length_axis = -1;
+  if (length_heading_rad) {
+    // The heading is known from elsewhere (the row the car is parked in): its axis is the
+    // length, and the near end may be all that was seen whatever angle the sight line makes.
+    const Eigen::Vector2d heading(std::cos(*length_heading_rad), std::sin(*length_heading_rad));
+    length_axis = std::abs(f.axis[0].dot(heading)) >= std::abs(f.axis[1].dot(heading)) ? 0 : 1;
+    const bool read_truncated = std::any_of(readings.begin(), readings.end(),
+                                            [&](const Reading& r) { return r.truncated_axis == length_axis; });
+    if (!read_truncated && !f.sight.isZero()) readings.push_back(ReadTruncated(f, length_axis, depth_spread_m));
+  }
+  const std::vector<Candidate> candidates =
+      Candidates(atlas, box.size.z(), readings, params, only_class, length_axis);
   const Candidate* best = Choose(atlas, candidates, params);
   ViewedBox out;
   out.box = box;
@@ -215,12 +231,16 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
 }
 
 ViewedBox CompleteAsClass(const Atlas& atlas, int class_index, const Box3& box, const Eigen::Vector2f& viewer_xy,
-                          const ViewCompletionParams& params, double depth_spread_m) {
+                          const ViewCompletionParams& params, double depth_spread_m,
+                          std::optional<double> length_heading_rad) {
   if (class_index < 0 || class_index >= static_cast<int>(atlas.classes().size())) {
     Fail("CompleteAsClass: class index " + std::to_string(class_index) + " is not in the atlas (" +
          std::to_string(atlas.classes().size()) + " classes)");
   }
-  return Classify(atlas, box, viewer_xy, params, depth_spread_m, class_index);
+  if (length_heading_rad && !std::isfinite(*length_heading_rad)) {
+    Fail("CompleteAsClass: non-finite length heading " + std::to_string(*length_heading_rad));
+  }
+  return Classify(atlas, box, viewer_xy, params, depth_spread_m, class_index, length_heading_rad);
 }
 
 }  // namespace romo::objects

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "romo/core/angles.hpp"
 #include "romo/core/check.hpp"
 #include "romo/mapping/segmentation.hpp"
 #include "romo/mapping/synthetic_scene.hpp"
@@ -19,12 +20,6 @@ constexpr float kPi = 3.14159265f;
 constexpr float kCentreToleranceM = 0.03f;
 constexpr float kSizeToleranceM = 0.04f;
 constexpr float kYawToleranceRad = 0.02f;  // ~1 deg: hull edges of a densely sampled footprint
-
-float AngleDiffHalfTurn(float a, float b) {
-  // Boxes are symmetric under 180 deg turns.
-  float d = std::fmod(std::abs(a - b), kPi);
-  return std::min(d, kPi - d);
-}
 
 mapping::SyntheticScene Scene(std::vector<mapping::SceneObject> objects, float noise_m = 0.f) {
   mapping::SyntheticSceneParams sp;
@@ -128,7 +123,7 @@ TEST(BoxFitTest, HeadingIsStableAcrossFramesWithoutFlips) {
       EXPECT_GE(b.size.x(), b.size.y());
       EXPECT_GE(b.yaw_rad, -kPi / 2);
       EXPECT_LT(b.yaw_rad, kPi / 2);
-      EXPECT_LT(AngleDiffHalfTurn(b.yaw_rad, yaw), 0.03f);
+      EXPECT_LT(AxisAngle(b.yaw_rad, yaw), 0.03f);
       // With the previous frame's yaw as hint, the heading is continuous (no wrap at the seam).
       const Box3 h = FitVerticalBox(scene.cloud.xyz, PointsOf(scene, 0), Eigen::Vector3f::UnitZ(),
                                     frame == 0 ? std::optional<float>(yaw) : std::optional<float>(previous));
@@ -185,8 +180,8 @@ TEST(BoxFitTest, HintedHeadingIsContinuousAcrossTheSeamOverFortyFrames) {
       if (car) {
         EXPECT_GE(pca.size.x(), pca.size.y()) << at;
         EXPECT_GE(vert.size.x(), vert.size.y()) << at;
-        EXPECT_LT(AngleDiffHalfTurn(pca.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
-        EXPECT_LT(AngleDiffHalfTurn(vert.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
+        EXPECT_LT(AxisAngle(pca.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
+        EXPECT_LT(AxisAngle(vert.yaw_rad, o.yaw_rad), kMaxCarYawErrorRad) << at;
       } else {
         EXPECT_LT(std::abs(std::remainder(vert.yaw_rad - o.yaw_rad, kPi / 2)), kMaxVerticalYawErrorRad) << at;
       }
@@ -253,7 +248,7 @@ TEST(BoxFitTest, TrimmedFitIgnoresStereoOutliers) {
   EXPECT_NEAR(trimmed.size.x(), 4.4f, 0.3f);
   EXPECT_NEAR(trimmed.size.y(), 1.8f, 0.15f);
   EXPECT_LT((trimmed.center.head<2>() - Eigen::Vector2f(9.f, 2.f)).norm(), 0.1f);
-  EXPECT_LT(AngleDiffHalfTurn(trimmed.yaw_rad, 0.3f), 2.f * kPi / 180.f);  // 1 degree search steps
+  EXPECT_LT(AxisAngle(trimmed.yaw_rad, 0.3f), 2.f * kPi / 180.f);  // 1 degree search steps
   EXPECT_THROW(FitVerticalBox(scene.cloud.xyz, idx, Eigen::Vector3f::UnitZ(), std::nullopt, 0.3f), romo::Error);
 }
 
@@ -296,11 +291,11 @@ TEST(BoxFitTest, DepthNoiseIsTakenOutOfAFarFacesHeading) {
   ASSERT_TRUE(heading.has_value());
   // Taking out noise twice the shape's own variance leaves a sampling error of 1-3 degrees with
   // 2700 points (seeds 1-13 tried); 5 degrees leaves margin, the rectangle is off by over 10.
-  EXPECT_LT(AngleDiffHalfTurn(*heading, kPi / 2), 5.f * kPi / 180.f);
-  EXPECT_GT(AngleDiffHalfTurn(smallest.yaw_rad, kPi / 2), 10.f * kPi / 180.f) << "the rectangle fit is not misled";
+  EXPECT_LT(AxisAngle(*heading, kPi / 2), 5.f * kPi / 180.f);
+  EXPECT_GT(AxisAngle(smallest.yaw_rad, kPi / 2), 10.f * kPi / 180.f) << "the rectangle fit is not misled";
   const Box3 along = FitVerticalBoxAtHeading(face.xyz, face.indices, Eigen::Vector3f::UnitZ(), *heading, 0.03f);
   // The heading or its perpendicular (the longer extent is the box's length: here the smear).
-  EXPECT_LT(std::fmod(AngleDiffHalfTurn(along.yaw_rad, *heading) + 1e-4f, kPi / 2), 2e-4f);
+  EXPECT_LT(std::fmod(AxisAngle(along.yaw_rad, *heading) + 1e-4f, kPi / 2), 2e-4f);
   const float across_sight = std::abs(std::sin(along.yaw_rad)) > 0.7f ? along.size.x() : along.size.y();
   // Along the face: 1.2 m less the 3 % trims, plus the smear's share across the sight line.
   EXPECT_NEAR(across_sight, 1.2f, 0.35f);
@@ -341,7 +336,7 @@ TEST(BoxFitTest, EdgeClosenessFindsTheHeadingOfANoisyCornerView) {
     const Box3 edges = FitVerticalBox(corner.xyz, corner.indices, Eigen::Vector3f::UnitZ(), std::nullopt, 0.03f,
                                       HeadingCriterion::kEdgeCloseness);
     // A rectangle's heading repeats every quarter turn.
-    auto off = [](float yaw) { return std::min(AngleDiffHalfTurn(yaw, 0.f), AngleDiffHalfTurn(yaw, kPi / 2)) * 180.0 / kPi; };
+    auto off = [](float yaw) { return std::min(AxisAngle(yaw, 0.f), AxisAngle(yaw, kPi / 2)) * 180.0 / kPi; };
     worst_closeness = std::max(worst_closeness, off(edges.yaw_rad));
     worst_area = std::max(worst_area, off(area.yaw_rad));
     mean_area += off(area.yaw_rad) / kSeeds;

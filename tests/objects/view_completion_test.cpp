@@ -185,6 +185,29 @@ TEST(ViewCompletionTest, CompletingAsAKnownClassKeepsTheNearFaceOrSaysUnknown) {
   EXPECT_THROW(CompleteAsClass(atlas, -1, front, Eigen::Vector2f::Zero()), romo::Error);
 }
 
+TEST(ViewCompletionTest, AKnownHeadingMakesItsAxisTheLengthAtAnyAngleToTheSightLine) {
+  const Atlas atlas = Load();
+  const int car = atlas.Require("car");
+  const double car_length = atlas.classes()[static_cast<std::size_t>(car)].length.mean_m;
+  // A car parked heading along x, its front face 1.8 m wide at x = 6 m, seen from the origin at
+  // 55 deg to its axis (its neighbours hide its side): 0.6 m of smeared depth along x.
+  const Box3 front = MakeBox({6.3f, 9.f}, 0.6f, 1.8f, 1.4f, 0.f);
+  // Alone, the axis nearer the sight line (35 deg) is y, the face's width: read as truncated
+  // there, the 0.6 m along x is a car's length or width, too short for either.
+  const ViewedBox alone = CompleteAsClass(atlas, car, front, Eigen::Vector2f::Zero());
+  EXPECT_EQ(alone.classification.class_index, atlas.unknown_index());
+  // With the row's heading (x) the length lies along x and only its near end was seen.
+  const ViewedBox in_row = CompleteAsClass(atlas, car, front, Eigen::Vector2f::Zero(), {}, 0.0, 0.0);
+  ASSERT_EQ(in_row.classification.class_index, car);
+  ASSERT_TRUE(in_row.completed);
+  EXPECT_NEAR(std::abs(std::cos(in_row.box.yaw_rad)), 1.0, 1e-5);
+  EXPECT_NEAR(in_row.box.size.x(), car_length, 1e-5);
+  EXPECT_NEAR(in_row.box.size.y(), 1.8, 1e-5);
+  EXPECT_NEAR(in_row.box.center.x(), 6.0 + car_length / 2, 1e-5);  // the near face stays put
+  EXPECT_NEAR(in_row.box.center.y(), 9.0, 1e-5);
+  EXPECT_THROW(CompleteAsClass(atlas, car, front, Eigen::Vector2f::Zero(), {}, 0.0, NAN), romo::Error);
+}
+
 TEST(ViewCompletionTest, NonFiniteInputIsAnError) {
   const Atlas atlas = Load();
   Box3 b = MakeBox({5.f, 0.f}, 1.f, 1.f, 1.f, 0.f);

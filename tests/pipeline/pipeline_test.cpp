@@ -547,6 +547,17 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.stacked_merge_gap_m = -0.1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.stacked_merge_gap_m = 0.5;
+  params.row_align_min_off_deg = 90.0;  // no heading is that far off a row's
+  try {
+    params.Validate();
+    FAIL() << "no error";
+  } catch (const romo::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("row_align_"), std::string::npos) << e.what();
+  }
+  params.row_align_min_off_deg = 20.0;
+  params.row_align_free_ground_points = 0;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.row_align_free_ground_points = 10;
   EXPECT_NO_THROW(params.Validate());
 }
 

@@ -4,11 +4,15 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
+#include "romo/core/angles.hpp"
 #include "romo/core/check.hpp"
 #include "romo/objects/atlas.hpp"
 #include "romo/objects/geo.hpp"
@@ -230,6 +234,17 @@ void PipelineParams::Validate() const {
   if (!(stacked_merge_xy_m >= 0 && stacked_merge_gap_m >= 0)) {
     Fail("pipeline: stacked_merge_xy_m and stacked_merge_gap_m must be >= 0, got " +
          std::to_string(stacked_merge_xy_m) + " m, " + std::to_string(stacked_merge_gap_m) + " m");
+  }
+  if (!(row_align_min_cars >= 0 && row_align_radius_m > 0 && row_align_max_offset_m > 0 &&
+        row_align_min_range_m >= 0 && row_align_min_off_deg >= 0 && row_align_min_off_deg < 90 &&
+        row_align_min_agreeing >= 0 && row_align_free_ground_margin_m >= 0 && row_align_free_ground_points >= 1)) {
+    Fail("pipeline: row_align_* out of range (min cars " + std::to_string(row_align_min_cars) + " >= 0, radius " +
+         std::to_string(row_align_radius_m) + " m > 0, max offset " + std::to_string(row_align_max_offset_m) +
+         " m > 0, min range " + std::to_string(row_align_min_range_m) + " m >= 0, min off " +
+         std::to_string(row_align_min_off_deg) + " deg in [0, 90), min agreeing " +
+         std::to_string(row_align_min_agreeing) + " >= 0, free ground margin " +
+         std::to_string(row_align_free_ground_margin_m) + " m >= 0, points " +
+         std::to_string(row_align_free_ground_points) + " >= 1)");
   }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
@@ -539,6 +554,91 @@ class Pipeline::Impl {
     }
   }
 
+  // The heading of the row of parked cars car @p i stands in (PipelineParams::row_align_*): across
+  // the line through the most measured car centres near it, if enough lie on one.
+  std::optional<double> RowHeading(const FrameResult& r, const std::vector<std::size_t>& cars, std::size_t i) const {
+    const Eigen::Vector2d ci = r.boxes[i].center.head<2>().cast<double>();
+    std::vector<Eigen::Vector2d> near;
+    for (std::size_t j : cars) {
+      const Eigen::Vector2d cj = r.boxes[j].center.head<2>().cast<double>();
+      if ((cj - ci).norm() <= params.row_align_radius_m) near.push_back(cj);
+    }
+    // The line through this car and another holding the most others (the row across the aisle
+    // and odd boxes are not on it), then refined by the inliers' principal axis.
+    std::vector<Eigen::Vector2d> row;
+    for (const Eigen::Vector2d& cj : near) {
+      if ((cj - ci).norm() < 1e-6) continue;
+      const Eigen::Vector2d normal = Eigen::Vector2d(-(cj - ci).y(), (cj - ci).x()).normalized();
+      std::vector<Eigen::Vector2d> on_line;
+      for (const Eigen::Vector2d& ck : near) {
+        if (std::abs(normal.dot(ck - ci)) <= params.row_align_max_offset_m) on_line.push_back(ck);
+      }
+      if (on_line.size() > row.size()) row = std::move(on_line);
+    }
+    if (static_cast<int>(row.size()) < params.row_align_min_cars) return std::nullopt;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& c : row) mean += c / static_cast<double>(row.size());
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (const Eigen::Vector2d& c : row) scatter += (c - mean) * (c - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+    const Eigen::Vector2d along = eigen.eigenvectors().col(1);
+    std::vector<double> positions;
+    for (const Eigen::Vector2d& c : row) positions.push_back(along.dot(c));
+    std::sort(positions.begin(), positions.end());
+    double spacing = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 1; k < positions.size(); ++k) spacing = std::min(spacing, positions[k] - positions[k - 1]);
+    const objects::SizePrior& length = atlas.classes()[static_cast<std::size_t>(car_class)].length;
+    // Closer than a car is long: side by side, not one behind the other.
+    if (spacing >= length.mean_m - length.sigma_m) return std::nullopt;
+    return std::atan2(along.y(), along.x()) + kPi / 2;
+  }
+
+  // Whether the ground shows inside @p box's footprint (vehicle frame), less
+  // PipelineParams::row_align_free_ground_margin_m all round: nothing stands there.
+  bool GroundSeenUnder(const FrameResult& r, const objects::Box3& box) const {
+    const double m = params.row_align_free_ground_margin_m;
+    return PointsInsideFootprint(r.cloud, r.ground_indices, box.center.head<2>().cast<double>(), box.yaw_rad,
+                                 0.5 * box.size.x() - m, 0.5 * box.size.y() - m) >= params.row_align_free_ground_points;
+  }
+
+  // Far cars boxed off the heading of the row they stand in are refitted and completed along it
+  // (PipelineParams::row_align_*); the measured boxes (r.boxes) follow.
+  void AlignCarsToRow(FrameResult& r, const Eigen::Vector3f& up, const std::vector<Eigen::Vector2f>& viewers,
+                      std::vector<Seen>* seen) const {
+    if (params.row_align_min_cars <= 0 || car_class < 0) return;
+    std::vector<std::size_t> cars;
+    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+      const Seen& v = (*seen)[i];
+      if (v.on_ground && !v.framed && v.viewed.classification.class_index == car_class) cars.push_back(i);
+    }
+    const double min_off = params.row_align_min_off_deg * kPi / 180.0;
+    // Every row is read off the boxes as measured; the refits are applied after.
+    std::vector<std::pair<std::size_t, objects::Box3>> refits;
+    std::vector<objects::ViewedBox> completed;
+    for (std::size_t i : cars) {
+      if ((r.boxes[i].center.head<2>() - viewers[i]).norm() < params.row_align_min_range_m) continue;
+      const std::optional<double> heading = RowHeading(r, cars, i);
+      if (!heading || AxisAngle((*seen)[i].viewed.box.yaw_rad, *heading) <= min_off) continue;
+      const auto agreeing = std::count_if(cars.begin(), cars.end(), [&](std::size_t j) {
+        return j != i &&
+               (r.boxes[j].center.head<2>() - r.boxes[i].center.head<2>()).norm() <= params.row_align_radius_m &&
+               AxisAngle((*seen)[j].viewed.box.yaw_rad, *heading) <= min_off;
+      });
+      if (agreeing < params.row_align_min_agreeing) continue;
+      const objects::Box3 refit = objects::FitVerticalBoxAtHeading(r.cloud.xyz, r.blobs[i], up,
+                                                                   static_cast<float>(*heading), params.box_trim_fraction);
+      const objects::ViewedBox viewed = objects::CompleteAsClass(atlas, car_class, refit, viewers[i], params.completion,
+                                                                 (*seen)[i].depth_spread_m, *heading);
+      if (viewed.classification.class_index != car_class || GroundSeenUnder(r, viewed.box)) continue;
+      refits.emplace_back(i, refit);
+      completed.push_back(viewed);
+    }
+    for (std::size_t k = 0; k < refits.size(); ++k) {
+      r.boxes[refits[k].first] = refits[k].second;
+      (*seen)[refits[k].first].viewed = completed[k];
+    }
+  }
+
   // Splits long blobs seen across their length at a gap when both parts are cars
   // (PipelineParams::face_pair_*): the ends of two neighbouring parked cars.
   void SplitFacePairs(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
@@ -837,6 +937,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   s.SplitFacePairs(r, up, &viewers, &seen);
   s.SplitTandems(r, up, &viewers, &seen);
   s.UnclassifyFramedFaces(r, viewers, &seen);
+  s.AlignCarsToRow(r, up, viewers, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {

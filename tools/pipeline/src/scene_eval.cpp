@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "romo/core/angles.hpp"
 #include "romo/core/check.hpp"
 #include "romo/core/statistics.hpp"
 #include "romo/drivers/recording.hpp"
@@ -47,12 +48,6 @@ std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth
     out.emplace_back(i, j);
   }
   return out;
-}
-
-// The angle between two box headings, degrees in 0..90 (a box's front and back look alike).
-double AxisAngleDeg(double a_rad, double b_rad) {
-  double d = std::fmod(std::abs(a_rad - b_rad), kPi);
-  return std::min(d, kPi - d) * 180.0 / kPi;
 }
 
 // A world-frame heading as seen in the frame @p T_to maps into.

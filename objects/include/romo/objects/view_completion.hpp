@@ -5,6 +5,8 @@
 /// it the extent is measured. The class (and which footprint axis is its length) that explains the
 /// measured extents best wins, the truncated extent is free up to the prior's maximum, and it is
 /// then grown to the prior's mean away from the viewer: the near face, which was seen, stays put.
+#include <optional>
+
 #include <Eigen/Core>
 
 #include "romo/objects/atlas.hpp"
@@ -57,8 +59,12 @@ ViewedBox ClassifyFromViewpoint(const Atlas& atlas, const Box3& box, const Eigen
 /// The same for a class already known (e.g. voted by the box's track over earlier, fuller views):
 /// the box is scored and completed as @p class_index only; it stays unknown when its extents
 /// cannot be that class (a fragment too low or too long for it).
-/// @throws romo::Error as above, or for a class index outside the atlas.
+/// @param length_heading_rad the object's heading when known otherwise (the row a parked car
+///        stands in): the footprint axis nearest it is the length, and it may be truncated (only
+///        the near end seen) at any angle to the line of sight.
+/// @throws romo::Error as above, for a class index outside the atlas or a non-finite heading.
 ViewedBox CompleteAsClass(const Atlas& atlas, int class_index, const Box3& box, const Eigen::Vector2f& viewer_xy,
-                          const ViewCompletionParams& params = {}, double depth_spread_m = 0.0);
+                          const ViewCompletionParams& params = {}, double depth_spread_m = 0.0,
+                          std::optional<double> length_heading_rad = std::nullopt);
 
 }  // namespace romo::objects

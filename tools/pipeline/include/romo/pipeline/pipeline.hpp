@@ -98,6 +98,26 @@ struct PipelineParams {
   double framed_occluder_margin_m = 0.8;
   /// How far beyond an end (degrees, seen from the camera) a nearer object still frames it.
   double framed_end_gap_deg = 6.0;
+  /// Cars parked side by side stand across the line through their seen ends: a car at least
+  /// row_align_min_range_m away whose heading is more than row_align_min_off_deg off that of the
+  /// row it stands in is refitted and completed along the row's. Far off, stereo smears a car's
+  /// end seen obliquely along the sight line, and its box follows the sight line instead of the
+  /// car (40-50 deg off, its centre 1.5-2 m away on the simulated scene). A row is at least
+  /// row_align_min_cars cars (this one among them) whose measured centres lie within
+  /// row_align_max_offset_m of one line and within row_align_radius_m of this car, neighbours
+  /// closer along it than a car is long (Atlas length mean less a sigma), and at least
+  /// row_align_min_agreeing of the others boxed along the row's heading already. A refit whose
+  /// completed footprint, less row_align_free_ground_margin_m all round, holds
+  /// row_align_free_ground_points ground points is no car there and is not taken (a car's side
+  /// seen through a gap reads as its end, and is completed out over the ground behind). 0 cars = off.
+  int row_align_min_cars = 3;
+  double row_align_radius_m = 12.0;
+  double row_align_max_offset_m = 0.3;
+  double row_align_min_range_m = 8.0;
+  double row_align_min_off_deg = 20.0;
+  int row_align_min_agreeing = 1;
+  double row_align_free_ground_margin_m = 0.1;
+  int row_align_free_ground_points = 10;
   /// A box whose bottom is higher than this above the ground plane is not a car or pedestrian.
   double max_ground_gap_m = 0.4;
   /// Parked cars are remembered in the world frame while the ground under them stays unseen: a
