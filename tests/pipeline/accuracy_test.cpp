@@ -110,12 +110,14 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // pedestrian P 0.686 R 0.713, centre 0.229 m. Session 12: far cars in a row take the row's
   // heading (PipelineParams::row_align_*): car P 0.853 -> 0.883, R 0.577 -> 0.629 (visible 0.642
   // -> 0.694), pedestrian P 0.731 -> 0.723, R 0.715 -> 0.724, centre 0.221 -> 0.227 m (more far
-  // cars matched), car yaw 8.5 -> 6.9 deg. About 1.5 % (5 of 300 sightings a scene) of margin.
+  // cars matched), car yaw 8.5 -> 6.9 deg; then person-sized pieces inside a hidden remembered
+  // parked car left of no class: pedestrian P 0.723 -> 0.765, R 0.724 -> 0.718, car P 0.883 ->
+  // 0.878, R 0.629 -> 0.630. About 1.5 % (5 of 300 sightings a scene) of margin.
   EXPECT_GE(mean.car_p, 0.865);
   EXPECT_GE(mean.car_r, 0.615);
   EXPECT_GE(mean.car_visible_r, 0.68);
-  EXPECT_GE(mean.ped_p, 0.71);
-  EXPECT_GE(mean.ped_r, 0.71);
+  EXPECT_GE(mean.ped_p, 0.75);
+  EXPECT_GE(mean.ped_r, 0.705);
   EXPECT_GE(mean.ped_visible_r, 0.76);
   EXPECT_LE(mean.centre_m, 0.23);
   EXPECT_LE(mean.car_yaw_deg, 8.0);

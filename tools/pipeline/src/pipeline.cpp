@@ -80,15 +80,22 @@ Eigen::Vector2f BlobViewer(const std::vector<int>& blob, const std::vector<int>&
 
 // How many of @p indices' points lie inside the footprint (vehicle frame) centred at @p xy with
 // heading @p yaw and half extents @p half_length, @p half_width.
+// Whether @p offset from a footprint's centre lies inside the footprint (heading @p yaw).
+bool InsideFootprint(const Eigen::Vector2d& offset, double yaw, double half_length, double half_width) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return std::abs(c * offset.x() + s * offset.y()) <= half_length &&
+         std::abs(-s * offset.x() + c * offset.y()) <= half_width;
+}
+
 int PointsInsideFootprint(const PointCloud& cloud, const std::vector<int>& indices, const Eigen::Vector2d& xy,
                           double yaw, double half_length, double half_width) {
   if (half_length <= 0.0 || half_width <= 0.0) return 0;
-  const double c = std::cos(yaw), s = std::sin(yaw), reach2 = half_length * half_length + half_width * half_width;
+  const double reach2 = half_length * half_length + half_width * half_width;
   int inside = 0;
   for (int i : indices) {
     const Eigen::Vector2d d = cloud.xyz.col(i).head<2>().cast<double>() - xy;
     if (d.squaredNorm() > reach2) continue;
-    inside += std::abs(c * d.x() + s * d.y()) <= half_length && std::abs(-s * d.x() + c * d.y()) <= half_width;
+    inside += InsideFootprint(d, yaw, half_length, half_width);
   }
   return inside;
 }
@@ -402,6 +409,7 @@ class Pipeline::Impl {
     double depth_spread_m = 0.0;
     objects::ViewedBox viewed;
     bool framed = false;  // cut off by nearer objects at both ends: its extents are no evidence
+    bool part_of_parked_car = false;  // a piece of a remembered parked car hidden now
   };
   Seen See(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob, const Eigen::Vector3f& up,
            const Eigen::Vector2f& viewer) const {
@@ -414,6 +422,28 @@ class Pipeline::Impl {
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
     return seen;
   }
+  // Pedestrian detections (world frame) inside a remembered parked car that no car detection
+  // stands in now are pieces of its end broken up by stereo (PipelineParams::
+  // parked_pieces_unclassified): of no class, and their tracks' votes do not make them people.
+  void UnclassifyPiecesOfHiddenParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
+    if (!params.parked_pieces_unclassified || pedestrian_class < 0) return;
+    for (const auto& [id, car] : parked) {
+      const bool seen_as_car = std::any_of(detections->begin(), detections->end(), [&](const objects::Detection& d) {
+        return d.classification.class_index == car_class && (d.xy_m - car.xy_m).norm() < 0.5 * car.length_m;
+      });
+      if (seen_as_car) continue;
+      for (std::size_t i = 0; i < detections->size(); ++i) {
+        objects::Detection& d = (*detections)[i];
+        if (d.classification.class_index != pedestrian_class ||
+            !InsideFootprint(d.xy_m - car.xy_m, car.yaw_rad, 0.5 * car.length_m, 0.5 * car.width_m)) {
+          continue;
+        }
+        d.classification = {atlas.unknown_index(), 0.0};
+        (*seen)[i].part_of_parked_car = true;
+      }
+    }
+  }
+
   // Whether one of @p a, @p b stands on the ground and the other floats above it, less than
   // PipelineParams::stacked_merge_gap_m over it (legs and a torso).
   bool Stacked(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& a, const objects::Box3& b) const {
@@ -953,6 +983,10 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     detections.push_back(d);
   }
   s.PreferRememberedFootprints(r, &r.boxes, &detections);
+  s.UnclassifyPiecesOfHiddenParkedCars(&detections, &seen);
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(detections[i].classification.class_index)].name;
+  }
   r.status.stages.push_back({"classes", MsSince(t0)});
 
   // Stage: tracks.
@@ -964,7 +998,10 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // extents can be one (a fragment too low for a car stays unknown).
   for (const objects::Track& tr : r.tracks) {
     const int i = tr.detection_index;
-    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground || seen[i].framed) continue;
+    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground || seen[i].framed ||
+        seen[i].part_of_parked_car) {
+      continue;
+    }
     if (tr.class_index < 0 || tr.class_index == s.atlas.unknown_index() ||
         tr.class_index == detections[i].classification.class_index) {
       continue;
