@@ -44,15 +44,18 @@ TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
   // warm-up move RSS by a few MB over the window. 3 MB/min (90 MB over 30 min) separates them.
   constexpr double kMaxRssSlopeMbPerMin = 3.0;
   EXPECT_LT(JsonNumber(json, "slope_mb_per_min"), kMaxRssSlopeMbPerMin) << json;
-  // Every loop replays the same frames, so the tracks held per frame must be the same in the
-  // last whole loop as in the first: one track never pruned per loop adds 1 to the mean per loop
+  // Every loop replays the same frames, so the tracks held per frame must not grow from the
+  // first whole loop to the last: one track never pruned per loop adds 1 to the mean per loop
   // (13 over the ~14 loops compared here). Loop means vary by thread timing between 51.8 and 54.5
-  // (measured, 21 loops), so 3 tracks separates the two.
+  // (measured, 21 loops), so 3 tracks separates the two. Later loops may hold fewer: parked cars
+  // remembered from the loop before make the person-sized pieces of their ends no pedestrians
+  // (PipelineParams::parked_pieces_unclassified; measured 48.3 in the first loop, 45.3 in the last).
   const std::size_t tracks_at = json.find("\"tracks_per_frame\"");
   ASSERT_NE(tracks_at, std::string::npos);
   const std::string tracks = json.substr(tracks_at);
   ASSERT_GE(JsonNumber(tracks, "loops_compared"), 2.0) << "too few whole loops measured:\n" << json;
-  EXPECT_NEAR(JsonNumber(tracks, "last_loop"), JsonNumber(tracks, "first_loop"), 3.0) << json;
+  EXPECT_LT(JsonNumber(tracks, "last_loop") - JsonNumber(tracks, "first_loop"), 3.0) << json;
+  EXPECT_GT(JsonNumber(tracks, "last_loop"), 0.5 * JsonNumber(tracks, "first_loop")) << "tracks lost:\n" << json;
   // Time per frame: a structure growing with the frames processed makes every frame cost more, so
   // CPU time per frame and wall latency rise together. This host moves both by itself: loop means
   // of CPU per frame went 334 -> 196 ms within 100 s alone, and another run rose 19 %/min with
