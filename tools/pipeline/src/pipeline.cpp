@@ -427,7 +427,8 @@ class Pipeline::Impl {
   // parked_pieces_unclassified): of no class, and their tracks' votes do not make them people.
   void UnclassifyPiecesOfHiddenParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
     if (!params.parked_pieces_unclassified || pedestrian_class < 0) return;
-    for (const auto& [id, car] : parked) {
+    for (const auto& entry : parked) {
+      const objects::Detection& car = entry.second;  // (a structured binding cannot be captured in C++17)
       const bool seen_as_car = std::any_of(detections->begin(), detections->end(), [&](const objects::Detection& d) {
         return d.classification.class_index == car_class && (d.xy_m - car.xy_m).norm() < 0.5 * car.length_m;
       });
