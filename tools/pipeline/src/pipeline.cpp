@@ -78,8 +78,6 @@ Eigen::Vector2f BlobViewer(const std::vector<int>& blob, const std::vector<int>&
   return calibration.rig(rig).T_vehicle_rig.translation().head<2>().cast<float>();
 }
 
-// How many of @p indices' points lie inside the footprint (vehicle frame) centred at @p xy with
-// heading @p yaw and half extents @p half_length, @p half_width.
 // Whether @p offset from a footprint's centre lies inside the footprint (heading @p yaw).
 bool InsideFootprint(const Eigen::Vector2d& offset, double yaw, double half_length, double half_width) {
   const double c = std::cos(yaw), s = std::sin(yaw);
@@ -87,6 +85,8 @@ bool InsideFootprint(const Eigen::Vector2d& offset, double yaw, double half_leng
          std::abs(-s * offset.x() + c * offset.y()) <= half_width;
 }
 
+// How many of @p indices' points lie inside the footprint (vehicle frame) centred at @p xy with
+// heading @p yaw and half extents @p half_length, @p half_width.
 int PointsInsideFootprint(const PointCloud& cloud, const std::vector<int>& indices, const Eigen::Vector2d& xy,
                           double yaw, double half_length, double half_width) {
   if (half_length <= 0.0 || half_width <= 0.0) return 0;
@@ -330,10 +330,8 @@ class Pipeline::Impl {
       const objects::Detection& d = it->second;  // a car: only cars are remembered
       const std::string& car_name = atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name;
       const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
-      const double m = params.parked_footprint_margin_m;
-      const bool ground_seen = PointsInsideFootprint(r.cloud, r.ground_indices, xy, d.yaw_rad - r.ego_world.yaw_rad,
-                                                     0.5 * d.length_m - m, 0.5 * d.width_m - m) >=
-                               params.parked_free_ground_points;
+      const bool ground_seen = GroundShows(r, xy, d.yaw_rad - r.ego_world.yaw_rad, d.length_m, d.width_m,
+                                           params.parked_footprint_margin_m, params.parked_free_ground_points);
       if (ground_seen || xy.norm() > params.parked_max_range_m) {
         it = parked.erase(it);
         continue;
@@ -624,12 +622,12 @@ class Pipeline::Impl {
     return std::atan2(along.y(), along.x()) + kPi / 2;
   }
 
-  // Whether the ground shows inside @p box's footprint (vehicle frame), less
-  // PipelineParams::row_align_free_ground_margin_m all round: nothing stands there.
-  bool GroundSeenUnder(const FrameResult& r, const objects::Box3& box) const {
-    const double m = params.row_align_free_ground_margin_m;
-    return PointsInsideFootprint(r.cloud, r.ground_indices, box.center.head<2>().cast<double>(), box.yaw_rad,
-                                 0.5 * box.size.x() - m, 0.5 * box.size.y() - m) >= params.row_align_free_ground_points;
+  // Whether at least @p min_points ground points show inside a footprint (vehicle frame) less
+  // @p margin_m all round: nothing stands there.
+  static bool GroundShows(const FrameResult& r, const Eigen::Vector2d& xy, double yaw, double length_m,
+                          double width_m, double margin_m, int min_points) {
+    return PointsInsideFootprint(r.cloud, r.ground_indices, xy, yaw, 0.5 * length_m - margin_m,
+                                 0.5 * width_m - margin_m) >= min_points;
   }
 
   // Far cars boxed off the heading of the row they stand in are refitted and completed along it
@@ -660,7 +658,12 @@ class Pipeline::Impl {
                                                                    static_cast<float>(*heading), params.box_trim_fraction);
       const objects::ViewedBox viewed = objects::CompleteAsClass(atlas, car_class, refit, viewers[i], params.completion,
                                                                  (*seen)[i].depth_spread_m, *heading);
-      if (viewed.classification.class_index != car_class || GroundSeenUnder(r, viewed.box)) continue;
+      const objects::Box3& b = viewed.box;
+      if (viewed.classification.class_index != car_class ||
+          GroundShows(r, b.center.head<2>().cast<double>(), b.yaw_rad, b.size.x(), b.size.y(),
+                      params.row_align_free_ground_margin_m, params.row_align_free_ground_points)) {
+        continue;
+      }
       refits.emplace_back(i, refit);
       completed.push_back(viewed);
     }
@@ -980,13 +983,12 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   for (std::size_t box_index = 0; box_index < r.boxes.size(); ++box_index) {
     r.boxes[box_index] = seen[box_index].viewed.box;
     const objects::Detection d = world_detection(r.boxes[box_index], seen[box_index].viewed.classification);
-    r.box_classes.push_back(s.atlas.classes()[d.classification.class_index].name);
     detections.push_back(d);
   }
   s.PreferRememberedFootprints(r, &r.boxes, &detections);
   s.UnclassifyPiecesOfHiddenParkedCars(&detections, &seen);
-  for (std::size_t i = 0; i < detections.size(); ++i) {
-    r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(detections[i].classification.class_index)].name;
+  for (const objects::Detection& d : detections) {
+    r.box_classes.push_back(s.atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name);
   }
   r.status.stages.push_back({"classes", MsSince(t0)});
 
