@@ -190,6 +190,66 @@ TEST(PipelineTest, ParkedCarIsRememberedWhileTheGroundUnderItIsUnseen) {
   EXPECT_TRUE(cars(without[7]).empty()) << "without the memory the track coasts 2 s at most";
 }
 
+// A parked car beside the vehicle shows only its side wall (the car 4..8.5 m ahead, its side at
+// y = 0.9 m, densely seen as from 1-2 m away) while stereo puts a few dozen mismatches of the
+// side's low part at ground height behind the wall, inside the footprint.
+RigInput ParkedCarSideWithGroundMismatches(std::int64_t stamp_ns) {
+  RigInput in = ParkedCarScene(stamp_ns, false, false);
+  for (float x = 5.0f; x <= 7.5f; x += 0.025f) {
+    for (float z = 0.3f; z <= 1.5f; z += 0.025f) in.cloud.PushBack({x, 0.9f, z}, 0.01f, 50.f);
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> along(5.0f, 7.5f), across(-0.5f, 0.5f);
+  for (int i = 0; i < 40; ++i) in.cloud.PushBack({along(rng), across(rng), 0.f}, 0.01f, 100.f);
+  return in;
+}
+
+TEST(PipelineTest, ANeighbourShowingItsSideIsNotForgottenForGroundMismatchesBehindIt) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // The remembered car's obstacle (num_points 0) or a car box near where it was seen.
+  auto car_near = [](const FrameResult& r, const planning_iface::Obstacle& seen) {
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.class_name == "car" && (o.center_m.head<2>() - seen.center_m.head<2>()).norm() < 0.5) return true;
+    }
+    return false;
+  };
+  auto run = [&](const PipelineParams& params, planning_iface::Obstacle* seen) {
+    Pipeline pipe(calibration, params);
+    std::int64_t t = 1'000'000'000;
+    FrameResult last;
+    for (int k = 0; k < 4; ++k, t += 100'000'000) {
+      last = pipe.ProcessClouds(t, k, {ParkedCarScene(t, true, false)}, std::nullopt, std::nullopt);
+    }
+    for (const auto& o : last.obstacles.obstacles) {
+      if (o.class_name == "car") *seen = o;
+    }
+    // Side-on for 4 s: longer than any track coasts (2 s), so only the memory can keep it.
+    std::vector<bool> kept;
+    for (int k = 4; k < 8; ++k, t += 1'000'000'000) {
+      kept.push_back(car_near(pipe.ProcessClouds(t, k, {ParkedCarSideWithGroundMismatches(t)}, std::nullopt,
+                                                 std::nullopt),
+                              *seen));
+    }
+    // Then the car is gone: ground where it stood, no wall.
+    kept.push_back(car_near(pipe.ProcessClouds(t, 8, {ParkedCarScene(t, false, true)}, std::nullopt, std::nullopt),
+                            *seen));
+    return kept;
+  };
+  planning_iface::Obstacle seen;
+  const std::vector<bool> kept = run(PipelineParams{}, &seen);
+  ASSERT_EQ(seen.class_name, "car");
+  for (std::size_t k = 0; k + 1 < kept.size(); ++k) {
+    EXPECT_TRUE(kept[k]) << "frame " << k + 4 << ": the neighbour whose side is in view was forgotten";
+  }
+  EXPECT_FALSE(kept.back()) << "the ground where it stood is in view and nothing stands there: it has left";
+
+  PipelineParams forgetful;
+  forgetful.parked_standing_points_ratio = 0.0;  // the rule before: any 20 ground points forget it
+  planning_iface::Obstacle seen_before;
+  const std::vector<bool> before = run(forgetful, &seen_before);
+  EXPECT_FALSE(before[3]) << "without the exception the 40 mismatches forget the car (the test's premise)";
+}
+
 // A parked van 6 m long (4..10 m ahead, 1.8 m wide, 1.8 m tall) in the front rig's cloud, the
 // ground under it hidden; @p seen_to_x cuts it (the field of view's edge) at that x.
 RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x) {
@@ -566,6 +626,9 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   EXPECT_THROW(params.Validate(), romo::Error);
   params.completion.face_min_score = 0.3;
   EXPECT_NO_THROW(params.Validate());
+  params.parked_standing_points_ratio = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_standing_points_ratio = 50.0;
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;

@@ -216,11 +216,11 @@ void PipelineParams::Validate() const {
     Fail("pipeline: box_trim_fraction must be in [0, 0.25], got " + std::to_string(box_trim_fraction));
   }
   if (parked_free_ground_points < 0 || !(parked_max_speed_mps >= 0) || !(parked_footprint_margin_m >= 0) ||
-      !(parked_max_range_m > 0)) {
+      !(parked_max_range_m > 0) || !(parked_standing_points_ratio >= 0 && std::isfinite(parked_standing_points_ratio))) {
     Fail("pipeline: parked_* out of range (ground points " + std::to_string(parked_free_ground_points) +
          " >= 0, speed " + std::to_string(parked_max_speed_mps) + " m/s >= 0, margin " +
          std::to_string(parked_footprint_margin_m) + " m >= 0, range " + std::to_string(parked_max_range_m) +
-         " m > 0)");
+         " m > 0, standing points ratio " + std::to_string(parked_standing_points_ratio) + " finite >= 0)");
   }
   if (!(tandem_min_length_m >= 0)) {
     Fail("pipeline: tandem_min_length_m must be >= 0, got " + std::to_string(tandem_min_length_m));
@@ -326,12 +326,24 @@ class Pipeline::Impl {
   std::vector<std::pair<int, objects::Detection>> HiddenParkedCars(const FrameResult& r) {
     std::vector<std::pair<int, objects::Detection>> hidden;
     const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
+    std::vector<int> object_points;
+    if (params.parked_standing_points_ratio > 0.0 && !parked.empty()) {
+      for (const auto& blob : r.blobs) object_points.insert(object_points.end(), blob.begin(), blob.end());
+    }
     for (auto it = parked.begin(); it != parked.end();) {
       const objects::Detection& d = it->second;  // a car: only cars are remembered
       const std::string& car_name = atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name;
       const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(d.xy_m.x(), d.xy_m.y(), 0.0)).head<2>();
-      const bool ground_seen = GroundShows(r, xy, d.yaw_rad - r.ego_world.yaw_rad, d.length_m, d.width_m,
-                                           params.parked_footprint_margin_m, params.parked_free_ground_points);
+      const double yaw = d.yaw_rad - r.ego_world.yaw_rad;
+      const double m = params.parked_footprint_margin_m;
+      const int ground = GroundPointsInside(r, xy, yaw, d.length_m, d.width_m, m);
+      // Ground "inside" a car whose faces are seen now is stereo's mismatches low on its side
+      // beside the vehicle, not the car gone (PipelineParams::parked_standing_points_ratio).
+      const bool still_standing =
+          params.parked_standing_points_ratio > 0.0 && ground >= params.parked_free_ground_points &&
+          PointsInsideFootprint(r.cloud, object_points, xy, yaw, 0.5 * d.length_m + m, 0.5 * d.width_m + m) >=
+              params.parked_standing_points_ratio * ground;
+      const bool ground_seen = ground >= params.parked_free_ground_points && !still_standing;
       if (ground_seen || xy.norm() > params.parked_max_range_m) {
         it = parked.erase(it);
         continue;
@@ -622,12 +634,16 @@ class Pipeline::Impl {
     return std::atan2(along.y(), along.x()) + kPi / 2;
   }
 
-  // Whether at least @p min_points ground points show inside a footprint (vehicle frame) less
-  // @p margin_m all round: nothing stands there.
+  // Ground points inside a footprint (vehicle frame) less @p margin_m all round.
+  static int GroundPointsInside(const FrameResult& r, const Eigen::Vector2d& xy, double yaw, double length_m,
+                                double width_m, double margin_m) {
+    return PointsInsideFootprint(r.cloud, r.ground_indices, xy, yaw, 0.5 * length_m - margin_m,
+                                 0.5 * width_m - margin_m);
+  }
+  // Whether at least @p min_points of them show: nothing stands there.
   static bool GroundShows(const FrameResult& r, const Eigen::Vector2d& xy, double yaw, double length_m,
                           double width_m, double margin_m, int min_points) {
-    return PointsInsideFootprint(r.cloud, r.ground_indices, xy, yaw, 0.5 * length_m - margin_m,
-                                 0.5 * width_m - margin_m) >= min_points;
+    return GroundPointsInside(r, xy, yaw, length_m, width_m, margin_m) >= min_points;
   }
 
   // Far cars boxed off the heading of the row they stand in are refitted and completed along it
