@@ -112,8 +112,10 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // -> 0.694), pedestrian P 0.731 -> 0.723, R 0.715 -> 0.724, centre 0.221 -> 0.227 m (more far
   // cars matched), car yaw 8.5 -> 6.9 deg; then person-sized pieces inside a hidden remembered
   // parked car left of no class: pedestrian P 0.723 -> 0.765, R 0.724 -> 0.718, car P 0.883 ->
-  // 0.878, R 0.629 -> 0.630. About 1.5 % (5 of 300 sightings a scene) of margin.
-  EXPECT_GE(mean.car_p, 0.865);
+  // 0.878, R 0.629 -> 0.630. Session 13: neighbours beside the vehicle kept in the memory
+  // (parked_standing_points_ratio): car P 0.878 -> 0.894, R 0.630 -> 0.635, car yaw 7.0 -> 7.95
+  // deg (more near neighbours matched). About 1.5 % (5 of 300 sightings a scene) of margin.
+  EXPECT_GE(mean.car_p, 0.885);
   EXPECT_GE(mean.car_r, 0.615);
   EXPECT_GE(mean.car_visible_r, 0.68);
   EXPECT_GE(mean.ped_p, 0.75);
