@@ -38,10 +38,7 @@ void Bench(const BenchOptions& o) {
     std::vector<drivers::FrameSet> frames;
     while (auto f = source.Next()) frames.push_back(std::move(*f));
     auto params_for = [&](int threads) {
-      pipeline::PipelineParams params;
-      params.threads = threads;
-      params.disparity_size = scale < 0.75 ? 64 : 128;
-      return params;
+      return pipeline::PipelineParams::ForCalibration(*source.calibration(), threads);
     };
     const double n = static_cast<double>(frames.size() - 1);
     // Mean stage and end-to-end latencies over the frames after a warm-up (allocations, first RANSAC).

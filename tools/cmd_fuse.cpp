@@ -148,8 +148,8 @@ void Fuse(const FuseOptions& o) {
   using Clock = std::chrono::steady_clock;
   const drivers::Calibration calibration =
       drivers::Calibration::Load(o.calib.empty() ? drivers::SampleCalibrationPath() : o.calib);
-  pipeline::PipelineParams params;
-  pipeline::Pipeline pipe(calibration, params);
+  // The same defaults as `romo replay` for these images (fuse runs no stereo: 1 thread).
+  pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, 1));
   pipeline::OutputOptions out;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;

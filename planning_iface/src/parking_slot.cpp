@@ -155,6 +155,9 @@ void ParkingParams::Validate() const {
   if (max_missed_frames < 0) {
     Fail("ParkingParams.max_missed_frames must be >= 0, got " + std::to_string(max_missed_frames));
   }
+  if (min_seen_frames < 1) {
+    Fail("ParkingParams.min_seen_frames must be >= 1, got " + std::to_string(min_seen_frames));
+  }
 }
 
 double FootprintDistance(const GroundBox& a, const GroundBox& b) {
@@ -442,6 +445,11 @@ std::vector<ParkingSlot> ParkingSlotEstimator::Update(const std::vector<GroundBo
   for (ParkingSlot& s : slots_) {
     s.target.yaw_rad = HeadingAlong(s.target.yaw_rad, ego.yaw_rad);
     EvaluateSlot(cars, ego, params_, &s);
+    if (s.feasible && s.seen_frames < params_.min_seen_frames) {
+      s.reason = "measured in " + std::to_string(s.seen_frames) + " frame(s), fewer than " +
+                 std::to_string(params_.min_seen_frames);
+      s.feasible = false;
+    }
     s.confidence = (1.0 - std::exp(-s.seen_frames / params_.confidence_frames)) *
                    std::pow(params_.miss_decay, s.missed_frames);
   }

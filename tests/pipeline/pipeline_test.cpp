@@ -600,6 +600,21 @@ TEST(PipelineTest, TheEndsOfTwoNeighbouringCarsBridgedByStereoAreTwoCars) {
   for (int k = 0; k < 2; ++k) EXPECT_NEAR(still_two[k].center_m.y(), k == 0 ? -1.3 : 1.3, 0.3);
 }
 
+TEST(PipelineTest, FullResolutionImagesTakeLShapeHeadingsAndTwiceTheDisparityRange) {
+  const auto full = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  const PipelineParams at_full = PipelineParams::ForCalibration(full, 2);
+  EXPECT_EQ(at_full.disparity_size, 128);
+  EXPECT_GT(at_full.edge_heading_min_length_m, 0.0);
+  auto half = full;
+  for (auto& rig : half.rigs) {
+    rig.width_px /= 2;
+    rig.height_px /= 2;
+  }
+  const PipelineParams at_half = PipelineParams::ForCalibration(half, 2);
+  EXPECT_EQ(at_half.disparity_size, 64);
+  EXPECT_EQ(at_half.edge_heading_min_length_m, 0.0) << "measured worse at half resolution";
+}
+
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, PipelineParams{});

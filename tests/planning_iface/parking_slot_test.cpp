@@ -234,6 +234,42 @@ TEST(ParkingSlotTest, EstimatorKeepsIdSmoothsNoiseAndReplansAsTheEgoMoves) {
   EXPECT_TRUE(slots.empty());
 }
 
+TEST(ParkingSlotTest, AGapMeasuredInOneFrameOnlyIsNeverFeasible) {
+  // A row of three cars 0.9 m apart. In one frame stereo misses the middle one, which leaves a
+  // 6.3 m "gap"; in the next ones only the first car is seen (the others lost too), so no
+  // measurement contradicts the gap and nothing seen stands in it: it must not be trusted.
+  const double pitch = kCarLength + 0.9;
+  const std::vector<GroundBox> middle_missed = {Car(0, 0.0, 5.0), Car(2, 2 * pitch, 5.0)};
+  const std::vector<GroundBox> first_only = {Car(0, 0.0, 5.0)};
+  Pose2 ego;
+  ego.position_m = {pitch, -3.0};
+  ego.yaw_rad = 0.0;
+  ParkingSlotEstimator estimator;
+  auto slots = estimator.Update(middle_missed, ego);
+  ASSERT_EQ(slots.size(), 1u);
+  EXPECT_FALSE(slots[0].feasible) << "one frame's gap";
+  EXPECT_NE(slots[0].reason.find("measured in 1 frame"), std::string::npos) << slots[0].reason;
+  for (int k = 0; k < 5; ++k) {
+    slots = estimator.Update(first_only, ego);
+    ASSERT_EQ(slots.size(), 1u) << "kept while unseen";
+    EXPECT_FALSE(slots[0].feasible) << "frame " << k + 1;
+  }
+  ParkingParams trusting;
+  trusting.min_seen_frames = 1;
+  ParkingSlotEstimator before(trusting);
+  before.Update(middle_missed, ego);
+  EXPECT_TRUE(before.Update(first_only, ego)[0].feasible) << "the test's premise: the rule alone stops it";
+  // Measured twice, the same gap is a slot.
+  ParkingSlotEstimator confirmed;
+  confirmed.Update(middle_missed, ego);
+  slots = confirmed.Update(middle_missed, ego);
+  ASSERT_EQ(slots.size(), 1u);
+  EXPECT_TRUE(slots[0].feasible) << slots[0].reason;
+  ParkingParams bad;
+  bad.min_seen_frames = 0;
+  EXPECT_THROW(bad.Validate(), Error);
+}
+
 TEST(ParkingSlotTest, NeighboursAreSmoothedLikeTheGapTheyBound) {
   // A perpendicular bay 3.3 m wide (the ego needs 3.2 m): 0.25 m to either neighbour once parked.
   const double h = kCarWidth / 2, gap = 3.3;

@@ -23,6 +23,7 @@ namespace romo::pipeline {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kFullResolutionEdgeHeadingM = 1.5;
 
 using Clock = std::chrono::steady_clock;
 
@@ -196,7 +197,11 @@ PipelineParams PipelineParams::ForCalibration(const drivers::Calibration& calibr
   ROMO_THROW_UNLESS(!calibration.rigs.empty());
   PipelineParams p;
   p.threads = threads;
-  p.disparity_size = calibration.rigs.front().width_px < 600 ? 64 : 128;
+  const bool full_resolution = calibration.rigs.front().width_px >= 600;
+  p.disparity_size = full_resolution ? 128 : 64;
+  // Half the depth noise makes the corner of a car seen obliquely an L, not a smear: its sides
+  // give the heading (see edge_heading_min_length_m).
+  if (full_resolution) p.edge_heading_min_length_m = kFullResolutionEdgeHeadingM;
   return p;
 }
 
