@@ -1,6 +1,7 @@
 // Accuracy of the whole stack on the simulated parking scene `romo run` uses (40 frames, half
-// resolution), over seeds 1-5 (seed 1 is `romo run`'s default): detection, boxes, tracks and the
-// parking slot against the scene's ground truth, scored by `romo eval scene`.
+// resolution), over seeds 1-5 (seed 1 is `romo run`'s default), and of seed 1 at full resolution:
+// detection, boxes, tracks and the parking slot against the scene's ground truth, scored by
+// `romo eval scene`.
 //
 // One seed's figures move by several sightings with any change to the stack (which blob a track
 // takes, which view a parked car is remembered from); the mean over five scenes is what a change
@@ -47,6 +48,27 @@ struct Means {
   }
 };
 
+void PrintSceneFigures(const std::string& what, const SceneEval& e) {
+  std::printf("FIGURE accuracy %s: car P %.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld), box "
+              "centre %.3f m, car yaw %.1f deg, ID switches %lld, slot %lld/%lld centre %.3f m yaw %.2f deg, "
+              "narrow feasible %lld\n",
+              what.c_str(), e.car.precision(), e.car.recall(), static_cast<long long>(e.car.matched_truths),
+              static_cast<long long>(e.car.truths), e.pedestrian.precision(), e.pedestrian.recall(),
+              static_cast<long long>(e.pedestrian.matched_truths), static_cast<long long>(e.pedestrian.truths),
+              e.box_center_err_m_median, e.car_yaw_err_deg_median, static_cast<long long>(e.id_switches),
+              static_cast<long long>(e.slot_found_frames), static_cast<long long>(e.slot_visible_frames),
+              e.slot_center_err_m, e.slot_yaw_err_deg, static_cast<long long>(e.narrow_reported_feasible));
+  std::printf("FIGURE accuracy %s, objects the cameras can see (>= %.0f %% of their facing surface): car P "
+              "%.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld)\n",
+              what.c_str(), 100 * SceneEvalParams{}.min_visible_fraction, e.car_visible.precision(), e.car_visible.recall(),
+              static_cast<long long>(e.car_visible.matched_truths), static_cast<long long>(e.car_visible.truths),
+              e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
+              static_cast<long long>(e.pedestrian_visible.matched_truths),
+              static_cast<long long>(e.pedestrian_visible.truths));
+  std::printf("FIGURE accuracy %s: box centre median cars %.3f m, pedestrians %.3f m\n", what.c_str(),
+              e.car.center_err_m_median, e.pedestrian.center_err_m_median);
+}
+
 TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   Means mean;
   for (int seed = 1; seed <= kSeeds; ++seed) {
@@ -55,24 +77,7 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     const auto run = romo::test::RunRomo("run --no-pictures --seed " + std::to_string(seed) + " --out " + dir.path());
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const SceneEval e = EvaluateSceneLog(dir / "outputs.lcmlog");
-    std::printf("FIGURE accuracy seed %d: car P %.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld), box "
-                "centre %.3f m, car yaw %.1f deg, ID switches %lld, slot %lld/%lld centre %.3f m yaw %.2f deg, "
-                "narrow feasible %lld\n",
-                seed, e.car.precision(), e.car.recall(), static_cast<long long>(e.car.matched_truths),
-                static_cast<long long>(e.car.truths), e.pedestrian.precision(), e.pedestrian.recall(),
-                static_cast<long long>(e.pedestrian.matched_truths), static_cast<long long>(e.pedestrian.truths),
-                e.box_center_err_m_median, e.car_yaw_err_deg_median, static_cast<long long>(e.id_switches),
-                static_cast<long long>(e.slot_found_frames), static_cast<long long>(e.slot_visible_frames),
-                e.slot_center_err_m, e.slot_yaw_err_deg, static_cast<long long>(e.narrow_reported_feasible));
-    std::printf("FIGURE accuracy seed %d, objects the cameras can see (>= %.0f %% of their facing surface): car P "
-                "%.3f R %.3f (%lld/%lld), pedestrian P %.3f R %.3f (%lld/%lld)\n",
-                seed, 100 * SceneEvalParams{}.min_visible_fraction, e.car_visible.precision(), e.car_visible.recall(),
-                static_cast<long long>(e.car_visible.matched_truths), static_cast<long long>(e.car_visible.truths),
-                e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
-                static_cast<long long>(e.pedestrian_visible.matched_truths),
-                static_cast<long long>(e.pedestrian_visible.truths));
-    std::printf("FIGURE accuracy seed %d: box centre median cars %.3f m, pedestrians %.3f m\n", seed,
-                e.car.center_err_m_median, e.pedestrian.center_err_m_median);
+    PrintSceneFigures("seed " + std::to_string(seed), e);
     // The median of all matched boxes lies between the two classes' medians.
     EXPECT_GE(e.box_center_err_m_median, std::min(e.car.center_err_m_median, e.pedestrian.center_err_m_median));
     EXPECT_LE(e.box_center_err_m_median, std::max(e.car.center_err_m_median, e.pedestrian.center_err_m_median));
@@ -125,6 +130,29 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   EXPECT_LE(mean.car_yaw_deg, 8.0);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
+}
+
+// The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo
+// work), seed 1 only to keep CI short. Here more of the targets are met, and asserted:
+// car precision >= 0.95, box centre within 0.2 m, the bay found in every frame it is fully
+// visible; recall stays below (floors a little under seed 1's figures: car P 0.971 R 0.665,
+// pedestrian P 0.923 R 0.730, centre 0.150 m, slot 32/32 at 0.051 m).
+TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
+  romo::test::ScratchDir dir;
+  const auto run = romo::test::RunRomo("run --no-pictures --scale 1 --seed 1 --out " + dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const SceneEval e = EvaluateSceneLog(dir / "outputs.lcmlog");
+  PrintSceneFigures("seed 1 at full resolution", e);
+  ASSERT_EQ(e.frames, 40);
+  EXPECT_EQ(e.narrow_reported_feasible, 0);
+  EXPECT_EQ(e.slot_found_frames, e.slot_visible_frames);
+  EXPECT_LE(e.slot_center_err_m, 0.15);
+  EXPECT_LE(e.slot_yaw_err_deg, 3.0);
+  EXPECT_LE(e.box_center_err_m_median, 0.2);
+  EXPECT_GE(e.car.precision(), 0.95);
+  EXPECT_GE(e.car.recall(), 0.64);
+  EXPECT_GE(e.pedestrian.precision(), 0.9);
+  EXPECT_GE(e.pedestrian.recall(), 0.70);
 }
 
 }  // namespace
