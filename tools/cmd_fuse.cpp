@@ -148,8 +148,11 @@ void Fuse(const FuseOptions& o) {
   using Clock = std::chrono::steady_clock;
   const drivers::Calibration calibration =
       drivers::Calibration::Load(o.calib.empty() ? drivers::SampleCalibrationPath() : o.calib);
-  // The same defaults as `romo replay` for these images (fuse runs no stereo: 1 thread).
-  pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, 1));
+  // Not ForCalibration: without --calib this is the full-size sample while the workers may send
+  // clouds of any image size, which fuse cannot tell; the plain defaults are half resolution's,
+  // as `romo replay` takes them for the half-size recordings workers are tested on.
+  pipeline::PipelineParams params;
+  pipeline::Pipeline pipe(calibration, params);
   pipeline::OutputOptions out;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
