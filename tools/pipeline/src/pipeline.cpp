@@ -331,10 +331,14 @@ class Pipeline::Impl {
   std::vector<std::pair<int, objects::Detection>> HiddenParkedCars(const FrameResult& r) {
     std::vector<std::pair<int, objects::Detection>> hidden;
     const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
+    // Every blob's points, gathered only once a memory shows ground (most frames none does).
     std::vector<int> object_points;
-    if (params.parked_standing_points_ratio > 0.0 && !parked.empty()) {
-      for (const auto& blob : r.blobs) object_points.insert(object_points.end(), blob.begin(), blob.end());
-    }
+    auto objects_inside = [&](const Eigen::Vector2d& xy, double yaw, double half_length, double half_width) {
+      if (object_points.empty()) {
+        for (const auto& blob : r.blobs) object_points.insert(object_points.end(), blob.begin(), blob.end());
+      }
+      return PointsInsideFootprint(r.cloud, object_points, xy, yaw, half_length, half_width);
+    };
     for (auto it = parked.begin(); it != parked.end();) {
       const objects::Detection& d = it->second;  // a car: only cars are remembered
       const std::string& car_name = atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name;
@@ -344,11 +348,11 @@ class Pipeline::Impl {
       const int ground = GroundPointsInside(r, xy, yaw, d.length_m, d.width_m, m);
       // Ground "inside" a car whose faces are seen now is stereo's mismatches low on its side
       // beside the vehicle, not the car gone (PipelineParams::parked_standing_points_ratio).
-      const bool still_standing =
-          params.parked_standing_points_ratio > 0.0 && ground >= params.parked_free_ground_points &&
-          PointsInsideFootprint(r.cloud, object_points, xy, yaw, 0.5 * d.length_m + m, 0.5 * d.width_m + m) >=
-              params.parked_standing_points_ratio * ground;
-      const bool ground_seen = ground >= params.parked_free_ground_points && !still_standing;
+      const bool ground_seen =
+          ground >= params.parked_free_ground_points &&
+          !(params.parked_standing_points_ratio > 0.0 &&
+            objects_inside(xy, yaw, 0.5 * d.length_m + m, 0.5 * d.width_m + m) >=
+                params.parked_standing_points_ratio * ground);
       if (ground_seen || xy.norm() > params.parked_max_range_m) {
         it = parked.erase(it);
         continue;
