@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# CI's second build: clang with AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g: Debug's
-# -O0 makes the simulator's renders too slow) and the libFuzzer targets, in one build directory.
+# CI's second build: clang with AddressSanitizer + UndefinedBehaviorSanitizer (-O1: Debug's -O0
+# makes the simulator's renders too slow; -gline-tables-only: reports still name file and line of
+# every frame, inlined ones included, and the build takes about a quarter less than with -g) and the libFuzzer targets, in one build directory.
 # Runs the unit tests in it (the whole suite with ROMO_ASAN_CTEST_ARGS=), then the fuzz smoke
 # (every target, ROMO_FUZZ_RUNS inputs from seed 1) with the same binaries.
 # .ci/run calls it after ./scripts/test.sh.
@@ -22,7 +23,8 @@ source scripts/sanitizers/env.sh
 t0=$(date +%s)
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
-  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
   -DROMO_SANITIZE=address,undefined -DROMO_FUZZ=ON
 cmake --build "$build_dir" -j "${ROMO_JOBS:-$(nproc)}"
 t1=$(date +%s)

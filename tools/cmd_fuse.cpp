@@ -11,13 +11,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <functional>
 #include <fstream>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -144,15 +148,62 @@ class Inbox {
   std::thread thread_;
 };
 
+// The pipeline, made once the first rig cloud says what size the workers' images are (its
+// defaults depend on it: full-resolution images take L-shape headings). Faults counted before
+// reach it when it is made.
+class FusePipeline {
+ public:
+  /// @throws romo::Error as Pipeline's constructor does, at once (not at the first cloud).
+  FusePipeline(const drivers::Calibration& calibration, pipeline::PipelineParams fallback)
+      : calibration_(calibration), fallback_(std::move(fallback)) {
+    const pipeline::Pipeline probe(calibration_, fallback_);
+  }
+
+  bool made() const { return pipe_ != nullptr; }
+  /// Makes it for clouds of @p image_width_px wide images (0: not said, the fallback params).
+  pipeline::Pipeline& Make(int image_width_px) {
+    if (pipe_) return *pipe_;
+    const int threads = fallback_.threads;
+    pipe_ = std::make_unique<pipeline::Pipeline>(
+        calibration_, image_width_px > 0 ? pipeline::PipelineParams::ForImageWidth(image_width_px, threads) : fallback_);
+    image_width_px_ = image_width_px;
+    for (const auto& fault : early_) fault(*pipe_);
+    early_.clear();
+    return *pipe_;
+  }
+  pipeline::Pipeline& Get() { return Make(0); }
+  int image_width_px() const { return image_width_px_; }
+
+  void CountMalformed() { Do([](pipeline::Pipeline& p) { p.CountMalformed(); }); }
+  void CountDropped(int rig_id) { Do([rig_id](pipeline::Pipeline& p) { p.CountDropped(rig_id); }); }
+  void ReportEvent(const std::string& event) { Do([event](pipeline::Pipeline& p) { p.ReportEvent(event); }); }
+
+ private:
+  template <typename F>
+  void Do(F f) {
+    if (pipe_) {
+      f(*pipe_);
+    } else {
+      early_.emplace_back(std::move(f));
+    }
+  }
+
+  const drivers::Calibration& calibration_;
+  const pipeline::PipelineParams fallback_;
+  std::unique_ptr<pipeline::Pipeline> pipe_;
+  int image_width_px_ = 0;
+  std::vector<std::function<void(pipeline::Pipeline&)>> early_;
+};
+
 void Fuse(const FuseOptions& o) {
   using Clock = std::chrono::steady_clock;
   const drivers::Calibration calibration =
       drivers::Calibration::Load(o.calib.empty() ? drivers::SampleCalibrationPath() : o.calib);
-  // Not ForCalibration: without --calib this is the full-size sample while the workers may send
-  // clouds of any image size, which fuse cannot tell; the plain defaults are half resolution's,
-  // as `romo replay` takes them for the half-size recordings workers are tested on.
-  pipeline::PipelineParams params;
-  pipeline::Pipeline pipe(calibration, params);
+  // Workers say their image size in each cloud; when they do not, a calibration given by --calib
+  // tells it, and the sample one (full-size, while workers may send clouds of any size) does not:
+  // the plain defaults are half resolution's, as `romo replay` takes them for half-size recordings.
+  FusePipeline pipe(calibration,
+                    o.calib.empty() ? pipeline::PipelineParams{} : pipeline::PipelineParams::ForCalibration(calibration, pipeline::PipelineParams{}.threads));
   pipeline::OutputOptions out;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
@@ -175,6 +226,7 @@ void Fuse(const FuseOptions& o) {
   // Newest stamp each rig has delivered: a worker publishes in stamp order, so a rig that has
   // sent a newer frame will not send an older one it skipped (no need to wait out the timeout).
   std::map<int, std::int64_t> newest_stamp;
+  std::set<int> mismatched_width_rigs;  // reported once each
   long long processed = 0, late = 0;
   // The idle clock starts with the first message: workers may take a while to start (loading,
   // first stereo), and fuse is a service that waits for them.
@@ -248,6 +300,17 @@ void Fuse(const FuseOptions& o) {
                        std::to_string(rc->frame_sequence) + ": its frame was fused without it");
       return;
     }
+    if (!pipe.made()) {
+      pipe.Make(rc->image_width_px);
+      std::fprintf(stderr, "romo fuse: defaults for %s (rig %d's first cloud)\n",
+                   rc->image_width_px > 0 ? (std::to_string(rc->image_width_px) + "-px images").c_str()
+                                          : "an image size the workers do not say",
+                   rc->rig_id);
+    } else if (rc->image_width_px > 0 && rc->image_width_px != pipe.image_width_px() &&
+               mismatched_width_rigs.insert(rc->rig_id).second) {
+      pipe.ReportEvent("rig " + std::to_string(rc->rig_id) + " sends clouds of " + std::to_string(rc->image_width_px) +
+                       "-px images; fuse took its defaults for " + std::to_string(pipe.image_width_px()) + " px");
+    }
     std::int64_t& newest = newest_stamp[rc->rig_id];
     newest = std::max(newest, rc->stamp_ns);
     Pending& p = pending[rc->stamp_ns];
@@ -273,7 +336,7 @@ void Fuse(const FuseOptions& o) {
       gnss = std::prev(fix)->second;
       ++frames_with_fix;
     }
-    const auto result = pipe.ProcessClouds(it->first, it->second.sequence, rigs, it->second.vehicle, gnss);
+    const auto result = pipe.Get().ProcessClouds(it->first, it->second.sequence, rigs, it->second.vehicle, gnss);
     sink.Write(nullptr, result, {});
     last_done_stamp = it->first;
     ++processed;
@@ -308,9 +371,10 @@ void Fuse(const FuseOptions& o) {
   }
   while (!pending.empty() && (o.frames <= 0 || processed < o.frames)) process(pending.begin());
   // Faults found after the last frame (bad or late messages) still reach the status and summary.
-  if (auto status = pipe.TakePendingStatus()) sink.WriteStatus(*status);
+  if (auto status = pipe.Get().TakePendingStatus()) sink.WriteStatus(*status);
   sink.Finish("\"late_clouds\": " + std::to_string(late) + ", \"frames_with_gnss\": " + std::to_string(frames_with_fix) +
-              ", \"geodetic\": " + (frames_with_fix > 0 ? "true" : "false"));
+              ", \"geodetic\": " + (frames_with_fix > 0 ? "true" : "false") +
+              ", \"image_width_px\": " + std::to_string(pipe.image_width_px()));
   std::fprintf(stderr, "romo fuse: %lld frames processed, %lld late clouds\n", processed, late);
 }
 

@@ -65,6 +65,7 @@ void Work(const WorkerOptions& o) {
     rc.cloud = std::move(in->cloud);
     rc.stereo_ms = in->stereo_ms;
     rc.vehicle = frames->vehicle;
+    rc.image_width_px = calibration.rig(o.rig).width_px;  // fuse takes its defaults for this size
     bus.Publish(planning_iface::RigCloudChannel(o.rig), planning_iface::Encode(rc));
     ++sent;
   }

@@ -78,7 +78,7 @@ bool WalkRigCloud(LcmWalker& w) {
   std::int32_t points = 0, coords = 0;
   return w.Skip(8 + 24 + 8) && w.Count(3, &points, "num_points") && w.Count(2, &coords, "num_coords") &&
          w.Skip(2 * static_cast<std::size_t>(coords)) && w.Skip(3 * static_cast<std::size_t>(points)) &&
-         w.Skip(8 + 1 + 8 * 9);
+         w.Skip(8 + 1 + 8 * 9 + 4);
 }
 
 bool Walk(const void* data, std::size_t size, bool (*walk)(LcmWalker&), const char* type,
@@ -442,6 +442,8 @@ std::vector<std::uint8_t> Encode(const RigCloud& rc, double scale_m) {
   msg.num_points = static_cast<std::int32_t>(msg.sigma_q.size());
   msg.num_coords = 3 * msg.num_points;
   msg.dropped_out_of_range = dropped;
+  ROMO_THROW_UNLESS(rc.image_width_px >= 0);
+  msg.image_width_px = rc.image_width_px;
   msg.has_vehicle = rc.vehicle.has_value();
   if (rc.vehicle) {
     const Eigen::Vector3d t = rc.vehicle->T_world_vehicle.translation();
@@ -486,6 +488,10 @@ std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::
                     " is more than 1 s from the frame's stamp_ns = " + std::to_string(msg.stamp_ns));
     return std::nullopt;
   }
+  if (msg.image_width_px < 0) {
+    SetWhy(why, "rig_cloud_t.image_width_px = " + std::to_string(msg.image_width_px) + " is negative");
+    return std::nullopt;
+  }
   for (std::int16_t s : msg.sigma_q) {
     if (s < 0) {
       SetWhy(why, "rig_cloud_t.sigma_q has a negative value " + std::to_string(s));
@@ -515,6 +521,7 @@ std::optional<RigCloud> DecodeRigCloud(const void* data, std::size_t size, std::
   out.rig_id = msg.rig_id;
   out.dropped_out_of_range = msg.dropped_out_of_range;
   out.stereo_ms = msg.stereo_ms;
+  out.image_width_px = msg.image_width_px;
   const std::size_t n = static_cast<std::size_t>(msg.num_points);
   out.cloud.Resize(n);
   const float scale = msg.scale_m;

@@ -36,6 +36,7 @@ constexpr int kRigs = 6;
 // Frames 90-105 of the default maneuver (half resolution): the parking slot is confirmed after
 // about 8 frames of history (filtered over frames), so half of them carry it.
 constexpr int kFrames = 16;
+constexpr int kRecordingWidthPx = 391;  // romo sim --scale 0.5 of the 782-px sample rigs
 
 double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -304,6 +305,9 @@ TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   const std::string fuse_summary = test::ReadFile(dir / "fuse/summary.json");
   EXPECT_NE(fuse_summary.find("\"frames_with_gnss\": " + std::to_string(kFrames)), std::string::npos) << fuse_summary;
   EXPECT_NE(fuse_summary.find("\"geodetic\": true"), std::string::npos) << fuse_summary;
+  // The workers said their images' size, so fuse took replay's defaults for it.
+  EXPECT_NE(fuse_summary.find("\"image_width_px\": " + std::to_string(kRecordingWidthPx)), std::string::npos)
+      << fuse_summary;
   EXPECT_FALSE(has_event("no GNSS fix yet"));
   ASSERT_FALSE(one.prediction_origins.empty());
   ASSERT_FALSE(fused.prediction_origins.empty());
@@ -404,9 +408,11 @@ TEST_F(WorkersFuseHilTest, KilledWorkerLeavesItsSectorMissingAndFuseKeepsPublish
 }
 
 // A rig cloud as a stereo worker would publish it: ground points in the rig's sector.
-std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std::int64_t sequence, int points) {
+std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std::int64_t sequence, int points,
+                                          int image_width_px = 0) {
   pi::RigCloud cloud;
   cloud.rig_id = rig_id;
+  cloud.image_width_px = image_width_px;
   cloud.stamp_ns = stamp_ns;
   cloud.capture_stamp_ns = stamp_ns;
   cloud.frame_sequence = sequence;
@@ -517,6 +523,45 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
               "injected (%d after the last frame), %lld counted; %zu statuses\n",
               kInjectedFrames, kRigs, injected, kTrailing, static_cast<long long>(last.malformed_messages),
               listener.statuses().size());
+}
+
+// Fuse's defaults depend on the workers' image size (full-resolution images take L-shape
+// headings), which only the clouds tell: the first cloud's size is taken, and a rig sending
+// another size is reported, once, while its clouds are still fused.
+TEST_F(WorkersFuseHilTest, FuseTakesItsDefaultsForTheImageSizeTheWorkersSay) {
+  test::ScratchDir dir;
+  const std::string url = LcmUrl(7814);
+  auto fuse = StartFuse(dir, url, "--idle-exit 2");
+  ASSERT_NE(fuse, nullptr);
+  StatusListener listener(ListenerUrl(7814));
+  pi::LcmBus bus(url);
+  constexpr int kSentFrames = 3, kPoints = 300, kFullWidthPx = 782, kOddRig = 5;
+  for (int k = 0; k < kSentFrames; ++k) {
+    const std::int64_t stamp = (k + 1) * 100000000LL;
+    for (int rig = 0; rig < kRigs; ++rig) {
+      const int width = rig == kOddRig ? kRecordingWidthPx : kFullWidthPx;
+      bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints, width));
+    }
+  }
+  ASSERT_TRUE(ExitedCleanly(fuse->Wait(60.0))) << test::ReadFile(dir / "fuse.err");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last status on its way
+  const std::string err = test::ReadFile(dir / "fuse.err");
+  EXPECT_NE(err.find("defaults for " + std::to_string(kFullWidthPx) + "-px images (rig 0's first cloud)"),
+            std::string::npos) << err;
+  const std::string summary = test::ReadFile(dir / "fuse/summary.json");
+  EXPECT_NE(summary.find("\"image_width_px\": " + std::to_string(kFullWidthPx)), std::string::npos) << summary;
+  int odd_size_reports = 0;
+  for (const auto& e : listener.events()) {
+    odd_size_reports += e.find("rig " + std::to_string(kOddRig) + " sends clouds of " +
+                               std::to_string(kRecordingWidthPx) + "-px images; fuse took its defaults for " +
+                               std::to_string(kFullWidthPx) + " px") != std::string::npos;
+  }
+  EXPECT_EQ(odd_size_reports, 1);
+  const auto statuses = listener.statuses();
+  ASSERT_GE(statuses.size(), static_cast<std::size_t>(kSentFrames));
+  for (int k = 0; k < kSentFrames; ++k) {
+    EXPECT_EQ(PresentRigs(statuses[static_cast<std::size_t>(k)]), kRigs) << "frame " << k;
+  }
 }
 
 }  // namespace

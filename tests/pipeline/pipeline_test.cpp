@@ -613,6 +613,19 @@ TEST(PipelineTest, FullResolutionImagesTakeLShapeHeadingsAndTwiceTheDisparityRan
   const PipelineParams at_half = PipelineParams::ForCalibration(half, 2);
   EXPECT_EQ(at_half.disparity_size, 64);
   EXPECT_EQ(at_half.edge_heading_min_length_m, 0.0) << "measured worse at half resolution";
+  // What a stereo worker says of its clouds gives romo fuse the same defaults.
+  const PipelineParams said_full = PipelineParams::ForImageWidth(full.rigs.front().width_px, 2);
+  const PipelineParams said_half = PipelineParams::ForImageWidth(half.rigs.front().width_px, 2);
+  EXPECT_EQ(said_full.edge_heading_min_length_m, at_full.edge_heading_min_length_m);
+  EXPECT_EQ(said_half.edge_heading_min_length_m, at_half.edge_heading_min_length_m);
+  EXPECT_EQ(said_full.disparity_size, at_full.disparity_size);
+  EXPECT_EQ(said_half.disparity_size, at_half.disparity_size);
+  try {
+    PipelineParams::ForImageWidth(0, 2);
+    FAIL() << "no error";
+  } catch (const romo::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("image width must be >= 1 px, got 0"), std::string::npos) << e.what();
+  }
 }
 
 TEST(PipelineTest, OutOfOrderStampIsAClearError) {

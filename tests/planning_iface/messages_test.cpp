@@ -1,6 +1,7 @@
 // LCM encodings of the planning outputs: round trips, and malformed messages rejected.
 #include "romo/planning_iface/messages.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -128,6 +129,7 @@ TEST(MessagesTest, RigCloudQuantisedToMillimetresAndOutOfRangeCounted) {
   in.rig_id = 4;
   in.stamp_ns = 1'000'000'077;
   in.capture_stamp_ns = in.stamp_ns - 30'000'000;  // captured 30 ms before its set's stamp
+  in.image_width_px = 782;
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-30.f, 30.f);
   for (int i = 0; i < 1001; ++i) in.cloud.PushBack({u(rng), u(rng), u(rng)}, 0.01f * (i % 50), float(i % 256));
@@ -141,6 +143,7 @@ TEST(MessagesTest, RigCloudQuantisedToMillimetresAndOutOfRangeCounted) {
   EXPECT_EQ(out->rig_id, 4);
   EXPECT_EQ(out->stamp_ns, in.stamp_ns);
   EXPECT_EQ(out->capture_stamp_ns, in.capture_stamp_ns);
+  EXPECT_EQ(out->image_width_px, 782);
   ASSERT_EQ(out->cloud.size(), 1001u);
   EXPECT_EQ(out->dropped_out_of_range, 1);
   for (std::size_t i = 0; i < out->cloud.size(); ++i) {
@@ -173,6 +176,11 @@ TEST(MessagesTest, MalformedMessagesAreRejectedWithAReason) {
   cloud_bytes[40] = 0x7f;  // after hash, stamp, sequence, capture stamp, rig id, scale
   EXPECT_FALSE(DecodeRigCloud(cloud_bytes.data(), cloud_bytes.size(), &why));
   EXPECT_NE(why.find("num_points"), std::string::npos) << why;
+  // A negative image width (the message's last field, big-endian int32).
+  auto width_bytes = Encode(rc);
+  std::fill(width_bytes.end() - 4, width_bytes.end(), std::uint8_t{0xff});
+  EXPECT_FALSE(DecodeRigCloud(width_bytes.data(), width_bytes.size(), &why));
+  EXPECT_NE(why.find("rig_cloud_t.image_width_px = -1 is negative"), std::string::npos) << why;
   // A rig said to have captured 2 s away from its frame set's stamp.
   rc.stamp_ns = 5'000'000'000;
   rc.capture_stamp_ns = 3'000'000'000;

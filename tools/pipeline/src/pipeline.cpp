@@ -195,9 +195,14 @@ stereo::SgmParameters PipelineParams::VehicleSgm() {
 
 PipelineParams PipelineParams::ForCalibration(const drivers::Calibration& calibration, int threads) {
   ROMO_THROW_UNLESS(!calibration.rigs.empty());
+  return ForImageWidth(calibration.rigs.front().width_px, threads);
+}
+
+PipelineParams PipelineParams::ForImageWidth(int image_width_px, int threads) {
+  if (image_width_px < 1) Fail("pipeline: image width must be >= 1 px, got " + std::to_string(image_width_px));
   PipelineParams p;
   p.threads = threads;
-  const bool full_resolution = calibration.rigs.front().width_px >= 600;
+  const bool full_resolution = image_width_px >= 600;
   p.disparity_size = full_resolution ? 128 : 64;
   // Half the depth noise makes the corner of a car seen obliquely an L, not a smear: its sides
   // give the heading (see edge_heading_min_length_m).

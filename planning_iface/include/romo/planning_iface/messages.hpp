@@ -94,6 +94,7 @@ struct RigCloud {
   int dropped_out_of_range = 0;  ///< points the compact encoding could not hold
   double stereo_ms = 0.0;
   std::optional<drivers::VehicleState> vehicle;  ///< odometry of the frame, when known
+  int image_width_px = 0;  ///< of the images the cloud was matched from (0: not said)
 };
 
 /// How far a rig's capture may lie from its frame set's stamp in a valid RigCloud.

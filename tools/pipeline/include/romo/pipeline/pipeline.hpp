@@ -176,6 +176,9 @@ struct PipelineParams {
   /// range for the same nearest depth; full-resolution ones take L-shape headings for long
   /// blobs) with @p threads stereo threads.
   static PipelineParams ForCalibration(const drivers::Calibration& calibration, int threads);
+  /// The same for rigs whose images are @p image_width_px wide (what a stereo worker says of
+  /// the clouds it sends). @throws romo::Error for a width < 1.
+  static PipelineParams ForImageWidth(int image_width_px, int threads);
   /// @throws romo::Error naming the field and value.
   void Validate() const;
 };
