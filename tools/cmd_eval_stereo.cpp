@@ -24,6 +24,7 @@ struct Options {
   std::string left, right, gt, gt_right, opencv_params;
   double gt_scale = 0.0;
   int ndisp = 0;
+  int refine_radius_px = 0;
   int opencv_window = 0;
   bool json = false;
 };
@@ -92,7 +93,9 @@ void Run(const Options& o) {
          ", right " + std::to_string(right.cols) + "x" + std::to_string(right.rows) + ", ground truth " +
          std::to_string(gt.left_px.cols) + "x" + std::to_string(gt.left_px.rows));
   }
-  stereo::StereoSgm sgm(left.cols, left.rows, o.ndisp, 8, 16);
+  stereo::SgmParameters params;
+  params.gradient_refine_radius_px = o.refine_radius_px;
+  stereo::StereoSgm sgm(left.cols, left.rows, o.ndisp, 8, 16, params);
   cv::Mat disparity;
   const auto t0 = std::chrono::steady_clock::now();
   sgm.execute(left, right, &disparity);
@@ -142,6 +145,9 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--gt-scale", opts->gt_scale, "disparity = PNG value / scale (Middlebury: 8, tsukuba 16)")
       ->required();
   cmd->add_option("--ndisp", opts->ndisp, "disparities searched by romo: multiple of 16 in [16, 256]")->required();
+  cmd->add_option("--refine-radius", opts->refine_radius_px,
+                  "romo's gradient subpixel refinement window radius, px (SgmParameters::gradient_refine_radius_px; 0 = off)")
+      ->capture_default_str();
   cmd->add_option("--gt-right", opts->gt_right,
                   "right ground truth for the occlusion mask (default: disp6.png beside --gt if present)");
   cmd->add_option("--opencv-params", opts->opencv_params,

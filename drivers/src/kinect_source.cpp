@@ -1,15 +1,19 @@
-// kinect://<index>: a Kinect v1 through libfreenect's sync API (RGB 640x480 + 11-bit depth).
+// kinect://<index>: a Kinect v1 through libfreenect (RGB 640x480 + 11-bit depth).
 // Recorded sessions replay through the same code with fakenect:
 //   fakenect DUMPDIR romo record --source kinect://0 --out session.lcmlog --frames N
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 #include <libfreenect.h>
-#include <libfreenect_sync.h>
 
 #include "romo/core/check.hpp"
 #include "romo/drivers/calibration.hpp"
@@ -54,24 +58,59 @@ const std::array<std::uint16_t, 2048>& RawToMillimetres() {
   return table;
 }
 
+// libfreenect's sync wrapper waits for the next frame without a timeout (forever once frames stop:
+// a device unplugged, a fakenect dump played to its end) and frees its buffers on its own thread
+// when the stream ends, while a reader may still be copying the last frame. The source runs the
+// event loop itself instead: frames are copied into its own buffers under its own lock, and a
+// stream that delivers nothing for the timeout ends, reported.
+constexpr std::chrono::seconds kFrameTimeout{2};        // the device delivers 30 frames per second
+constexpr std::chrono::seconds kFirstFrameTimeout{10};  // starting it takes a few seconds
+
 class KinectSource : public FrameSource {
  public:
   explicit KinectSource(int index) : index_(index), calibration_(DefaultKinectCalibration(index)) {
     counters_.camera_id = "kinect:" + std::to_string(index);
+    if (freenect_init(&context_, nullptr) < 0 || context_ == nullptr) {
+      Fail("kinect " + std::to_string(index) + ": libfreenect could not start");
+    }
+    if (freenect_open_device(context_, &device_, index) < 0 || device_ == nullptr) {
+      freenect_shutdown(context_);
+      Fail("kinect " + std::to_string(index) + ": the device could not be opened (in use by another program?)");
+    }
+    freenect_set_user(device_, this);
+    freenect_set_video_mode(device_, freenect_find_video_mode(FREENECT_RESOLUTION_MEDIUM, FREENECT_VIDEO_RGB));
+    freenect_set_depth_mode(device_, freenect_find_depth_mode(FREENECT_RESOLUTION_MEDIUM, FREENECT_DEPTH_11BIT));
+    video_buffer_.resize(static_cast<std::size_t>(kWidth) * kHeight * 3);
+    depth_buffer_.resize(static_cast<std::size_t>(kWidth) * kHeight);
+    freenect_set_video_buffer(device_, video_buffer_.data());
+    freenect_set_depth_buffer(device_, depth_buffer_.data());
+    freenect_set_video_callback(device_, &KinectSource::OnVideo);
+    freenect_set_depth_callback(device_, &KinectSource::OnDepth);
+    freenect_start_video(device_);
+    freenect_start_depth(device_);
+    events_thread_ = std::thread([this] { RunEvents(); });
   }
-  ~KinectSource() override { freenect_sync_stop(); }
+
+  ~KinectSource() override {
+    stop_ = true;
+    events_thread_.join();
+    freenect_stop_depth(device_);
+    freenect_stop_video(device_);
+    freenect_close_device(device_);
+    freenect_shutdown(context_);
+  }
 
   std::optional<FrameSet> Next() override {
-    void* rgb = nullptr;
-    void* depth = nullptr;
-    std::uint32_t rgb_ts = 0;
-    std::uint32_t depth_ts = 0;
-    if (freenect_sync_get_video(&rgb, &rgb_ts, index_, FREENECT_VIDEO_RGB) != 0 ||
-        freenect_sync_get_depth(&depth, &depth_ts, index_, FREENECT_DEPTH_11BIT) != 0) {
+    const auto timeout = counters_.completed == 0 ? kFirstFrameTimeout : kFrameTimeout;
+    std::unique_lock<std::mutex> lock(mutex_);
+    const bool arrived = frame_ready_.wait_for(lock, timeout, [this] { return (new_rgb_ && new_depth_) || ended_; });
+    if (!arrived || !(new_rgb_ && new_depth_)) {
       // An unplugged device or the end of a fakenect replay: the stream ends, reported.
       if (events_.empty()) {
-        events_.push_back("kinect " + std::to_string(index_) + " stopped delivering frames after " +
-                          std::to_string(counters_.completed));
+        events_.push_back("kinect " + std::to_string(index_) + " stopped after " + std::to_string(counters_.completed) +
+                          " frames: " +
+                          (ended_ ? std::string("its event loop ended (unplugged, or the end of a fakenect dump)")
+                                  : "no frame for " + std::to_string(timeout.count()) + " s (unplugged or hung)"));
       }
       return std::nullopt;
     }
@@ -83,12 +122,13 @@ class KinectSource : public FrameSource {
                        .count();
     RgbdFrame frame;
     frame.rgb = Image::Allocate(PixelFormat::kRgb8, kWidth, kHeight);
-    std::memcpy(frame.rgb.data.data(), rgb, frame.rgb.data.size());
+    std::memcpy(frame.rgb.data.data(), latest_rgb_.data(), frame.rgb.data.size());
     frame.depth = Image::Allocate(PixelFormat::kMono16, kWidth, kHeight);
     const auto& table = RawToMillimetres();
-    const auto* raw = static_cast<const std::uint16_t*>(depth);
     auto* mm = reinterpret_cast<std::uint16_t*>(frame.depth.data.data());
-    for (int i = 0; i < kWidth * kHeight; ++i) mm[i] = table[raw[i] & 0x07FF];
+    for (int i = 0; i < kWidth * kHeight; ++i) mm[i] = table[latest_depth_[static_cast<std::size_t>(i)] & 0x07FF];
+    new_rgb_ = new_depth_ = false;
+    lock.unlock();
     frame.depth_scale_m = 0.001;
     frame.stamp_ns = set.stamp_ns;
     frame.sequence = set.sequence;
@@ -108,10 +148,49 @@ class KinectSource : public FrameSource {
   const Calibration* calibration() const override { return &calibration_; }
 
  private:
+  void RunEvents() {
+    while (!stop_) {
+      timeval tv{0, 100000};
+      if (freenect_process_events_timeout(context_, &tv) < 0) break;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    ended_ = true;
+    frame_ready_.notify_all();
+  }
+
+  static void OnVideo(freenect_device* device, void* rgb, std::uint32_t) {
+    auto* self = static_cast<KinectSource*>(freenect_get_user(device));
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    const auto* bytes = static_cast<const std::uint8_t*>(rgb);
+    self->latest_rgb_.assign(bytes, bytes + self->video_buffer_.size());
+    self->new_rgb_ = true;
+    self->frame_ready_.notify_all();
+  }
+
+  static void OnDepth(freenect_device* device, void* depth, std::uint32_t) {
+    auto* self = static_cast<KinectSource*>(freenect_get_user(device));
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    const auto* raw = static_cast<const std::uint16_t*>(depth);
+    self->latest_depth_.assign(raw, raw + self->depth_buffer_.size());
+    self->new_depth_ = true;
+    self->frame_ready_.notify_all();
+  }
+
   int index_;
   Calibration calibration_;
   CameraCounters counters_;
   std::vector<std::string> events_;
+  freenect_context* context_ = nullptr;
+  freenect_device* device_ = nullptr;
+  std::vector<std::uint8_t> video_buffer_;   // libfreenect writes frames here
+  std::vector<std::uint16_t> depth_buffer_;
+  std::mutex mutex_;  // guards the latest frames and the flags below
+  std::condition_variable frame_ready_;
+  std::vector<std::uint8_t> latest_rgb_;
+  std::vector<std::uint16_t> latest_depth_;
+  bool new_rgb_ = false, new_depth_ = false, ended_ = false;
+  std::atomic<bool> stop_{false};
+  std::thread events_thread_;
 };
 
 }  // namespace

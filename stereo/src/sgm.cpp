@@ -58,6 +58,9 @@ void SgmParameters::Validate() const {
   if (pre_filter_cap < 1 || pre_filter_cap > 63) {
     bad("pre_filter_cap", std::to_string(pre_filter_cap), "must be in [1, 63]");
   }
+  if (gradient_refine_radius_px < 0 || gradient_refine_radius_px > 5) {
+    bad("gradient_refine_radius_px", std::to_string(gradient_refine_radius_px), "must be in [0, 5]");
+  }
   if (speckle_window_px < 0) bad("speckle_window_px", std::to_string(speckle_window_px), "must be >= 0");
   if (speckle_range_px < 0) bad("speckle_range_px", std::to_string(speckle_range_px), "must be >= 0");
   if (post_filter != PostFilter::kNone && post_filter != PostFilter::kMedian3 &&
@@ -122,6 +125,9 @@ class StereoSgm::Impl {
         filtered_.copyTo(raw);
         break;
       }
+    }
+    if (params_.subpixel && params_.gradient_refine_radius_px > 0) {
+      RefineDisparityByGradient(l, r, params_.gradient_refine_radius_px, kSubpixelScale, internal_invalid_, &raw);
     }
     if (direct) return;
     if (output_bits_ == 16 && params_.subpixel) {
@@ -247,6 +253,67 @@ void MedianFilterValid(cv::Mat* disparity, int invalid_disparity) {
         }
       }
       dst[x] = Median(window, n);
+    }
+  }
+}
+
+void RefineDisparityByGradient(const cv::Mat& left8, const cv::Mat& right8, int radius, int subpixel_scale,
+                               int invalid_disparity, cv::Mat* disparity) {
+  ROMO_THROW_UNLESS(disparity != nullptr && disparity->type() == CV_16SC1);
+  ROMO_THROW_UNLESS(left8.type() == CV_8UC1 && right8.type() == CV_8UC1 && left8.size() == right8.size() &&
+                    left8.size() == disparity->size());
+  ROMO_THROW_UNLESS(radius >= 1 && subpixel_scale > 0);
+  const int rows = left8.rows, cols = left8.cols;
+  cv::Mat left, right, left_dx, right_dx;
+  left8.convertTo(left, CV_32F);
+  right8.convertTo(right, CV_32F);
+  // Central differences (scale 1/2 per pixel).
+  cv::Sobel(left, left_dx, CV_32F, 1, 0, 1, 0.5);
+  cv::Sobel(right, right_dx, CV_32F, 1, 0, 1, 0.5);
+  const float scale = static_cast<float>(subpixel_scale);
+  const int n = (2 * radius + 1) * (2 * radius + 1);
+  // Below ~1 grey level of x-gradient per pixel the step is noise.
+  const double min_gradient_variance = 1.0 * n;
+  for (int y = radius; y < rows - radius; ++y) {
+    short* out = disparity->ptr<short>(y);
+    for (int x = radius; x < cols - radius; ++x) {
+      if (out[x] <= invalid_disparity) continue;
+      const double d0 = out[x] / scale;
+      double d = d0;
+      bool ok = true;
+      for (int iteration = 0; iteration < 2 && ok; ++iteration) {
+        double sg = 0, se = 0, sgg = 0, sge = 0;
+        for (int v = y - radius; v <= y + radius && ok; ++v) {
+          const float* l = left.ptr<float>(v);
+          const float* ldx = left_dx.ptr<float>(v);
+          const float* r = right.ptr<float>(v);
+          const float* rdx = right_dx.ptr<float>(v);
+          for (int u = x - radius; u <= x + radius; ++u) {
+            const double xr = u - d;
+            const int x0 = static_cast<int>(std::floor(xr));
+            if (x0 < 1 || x0 + 2 >= cols) {
+              ok = false;
+              break;
+            }
+            const double a = xr - x0;
+            const double rv = (1 - a) * r[x0] + a * r[x0 + 1];
+            const double g = 0.5 * (ldx[u] + (1 - a) * rdx[x0] + a * rdx[x0 + 1]);
+            const double e = rv - l[u];
+            sg += g;
+            se += e;
+            sgg += g * g;
+            sge += g * e;
+          }
+        }
+        if (!ok) break;
+        const double var_g = sgg - sg * sg / n;
+        if (var_g < min_gradient_variance) {
+          ok = false;
+          break;
+        }
+        d += (sge - sg * se / n) / var_g;
+      }
+      if (ok && std::abs(d - d0) < 1.0) out[x] = static_cast<short>(std::lround(d * scale));
     }
   }
 }

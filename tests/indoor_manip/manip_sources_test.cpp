@@ -106,7 +106,7 @@ TEST(ManipSourcesTest, FakenectDumpThroughKinectSource) {
   sim_manip::SimManipOptions o;
   o.action = "hitting";
   o.seed = 100;
-  o.frames = kFrames + 10;  // fakenect blocks at the end of a dump: keep spare frames
+  o.frames = kFrames + 10;  // spare frames: the stream ends when the dump does
   o.width_px = 640;
   o.height_px = 480;
   const sim_manip::SimManipScene scene(o);
@@ -153,11 +153,15 @@ TEST(ManipSourcesTest, FakenectDumpThroughKinectSource) {
   constexpr double kMaxPlaneAngleDeg = 1.0;
   EXPECT_LT(angle_deg, kMaxPlaneAngleDeg);
   const YAML::Node k = ReadJson(dir / "out/knowledge.json");
-  EXPECT_EQ(k["motions"]["frames"].as<int>(), kFrames);
-  // fakenect replays the dump by its timestamps, so frames repeat or go missing, and the 11-bit
-  // raw depth is coarser than the rendered one: the hand is re-found in most frames, not all
-  // (34 of 42 measured). Three quarters still shows tracking, not chance.
-  EXPECT_GE(k["motions"]["frames_with_hand"].as<int>(), kFrames * 3 / 4);
+  // fakenect replays the dump in real time, like a Kinect that does not wait: on a loaded machine
+  // a reader slower than 30 frames/s skips some (43 of 45 with four busy processes on 2 cores,
+  // measured), and the stream ends 2 s after the dump does. Two thirds is the floor.
+  const int frames = k["motions"]["frames"].as<int>();
+  EXPECT_LE(frames, kFrames);
+  EXPECT_GE(frames, kFrames * 2 / 3);
+  // The 11-bit raw depth is coarser than the rendered one: the hand is re-found in most frames,
+  // not all (34 of 42 measured). Three quarters still shows tracking, not chance.
+  EXPECT_GE(k["motions"]["frames_with_hand"].as<int>(), frames * 3 / 4);
 }
 
 // A two-frame rgbd:// folder (color/ + depth/, depth in mm) from the given images.

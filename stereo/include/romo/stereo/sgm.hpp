@@ -44,6 +44,10 @@ struct SgmParameters {
   int speckle_window_px = 100;  ///< largest blob (px) removed as speckle; 0 = no speckle filter
   int speckle_range_px = 2;  ///< max disparity step (px) inside one speckle blob
   PostFilter post_filter = PostFilter::kNone;
+  /// With subpixel output: each disparity is refined by 1-D Lucas-Kanade on the rectified pair
+  /// over a (2r+1)^2 window (RefineDisparityByGradient); 0 = OpenCV's parabola fit alone, which
+  /// pulls disparities toward whole pixels ("pixel locking").
+  int gradient_refine_radius_px = 0;
   /// @throws romo::Error naming the field and value.
   void Validate() const;
 };
@@ -97,5 +101,13 @@ cv::Mat DisparityToFloat(const cv::Mat& disparity, int subpixel_scale, int inval
 /// 3x3 median over valid pixels only, in place (the stage behind PostFilter::kMedian3).
 /// Pixels that are invalid stay invalid; a valid pixel takes the median of its valid neighbours.
 void MedianFilterValid(cv::Mat* disparity, int invalid_disparity);
+
+/// Refines a subpixel disparity map (value = disparity x @p subpixel_scale) of the rectified
+/// 8-bit pair in place: two Gauss-Newton steps of the window's zero-mean intensity difference
+/// between left and shifted right (x-gradients averaged over both images), window (2 @p radius
+/// + 1)^2. A pixel keeps its disparity where the window lacks x-texture, leaves either image,
+/// or the refinement moves it by a pixel or more (a depth edge).
+void RefineDisparityByGradient(const cv::Mat& left8, const cv::Mat& right8, int radius, int subpixel_scale,
+                               int invalid_disparity, cv::Mat* disparity);
 
 }  // namespace romo::stereo
