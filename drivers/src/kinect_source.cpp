@@ -160,20 +160,20 @@ class KinectSource : public FrameSource {
 
   static void OnVideo(freenect_device* device, void* rgb, std::uint32_t) {
     auto* self = static_cast<KinectSource*>(freenect_get_user(device));
-    std::lock_guard<std::mutex> lock(self->mutex_);
-    const auto* bytes = static_cast<const std::uint8_t*>(rgb);
-    self->latest_rgb_.assign(bytes, bytes + self->video_buffer_.size());
-    self->new_rgb_ = true;
-    self->frame_ready_.notify_all();
+    self->Keep(static_cast<const std::uint8_t*>(rgb), self->video_buffer_.size(), &self->latest_rgb_, &self->new_rgb_);
   }
-
   static void OnDepth(freenect_device* device, void* depth, std::uint32_t) {
     auto* self = static_cast<KinectSource*>(freenect_get_user(device));
-    std::lock_guard<std::mutex> lock(self->mutex_);
-    const auto* raw = static_cast<const std::uint16_t*>(depth);
-    self->latest_depth_.assign(raw, raw + self->depth_buffer_.size());
-    self->new_depth_ = true;
-    self->frame_ready_.notify_all();
+    self->Keep(static_cast<const std::uint16_t*>(depth), self->depth_buffer_.size(), &self->latest_depth_,
+               &self->new_depth_);
+  }
+  // A frame from libfreenect's thread: copied out of its buffer before the next one overwrites it.
+  template <typename T>
+  void Keep(const T* data, std::size_t count, std::vector<T>* latest, bool* fresh) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    latest->assign(data, data + count);
+    *fresh = true;
+    frame_ready_.notify_all();
   }
 
   int index_;

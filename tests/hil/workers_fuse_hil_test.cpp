@@ -426,6 +426,16 @@ std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std
   return pi::Encode(cloud);
 }
 
+// fuse on @p port started with @p fuse_args, a listener to its statuses and a bus to inject
+// messages on (in that order: fuse is subscribed before anything is sent).
+struct InjectedFuse {
+  InjectedFuse(const test::ScratchDir& dir, int port, const std::string& fuse_args)
+      : fuse(StartFuse(dir, LcmUrl(port), fuse_args)), listener(ListenerUrl(port)), bus(LcmUrl(port)) {}
+  std::unique_ptr<Background> fuse;
+  StatusListener listener;
+  pi::LcmBus bus;
+};
+
 // Found when this ran first (as a fault-injection case): fuse counted 18 of 24 bad messages and
 // processed frames with rigs missing. Cause: the kernel's default 208 kB UDP receive buffer
 // cannot hold a 240 kB oversized message (four 64 kB datagrams) plus the clouds after it while
@@ -433,13 +443,10 @@ std::vector<std::uint8_t> RigCloudMessage(int rig_id, std::int64_t stamp_ns, std
 // large buffer (--recv-buf-bytes) and reports in its status when the kernel caps it.
 TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEveryFrame) {
   test::ScratchDir dir;
-  const std::string url = LcmUrl(7813);
   // A small limit for the test: the oversized message is a valid cloud of 30000 points (240 kB).
   constexpr std::size_t kLimit = 100000;
-  auto fuse = StartFuse(dir, url, "--idle-exit 3 --max-message-bytes " + std::to_string(kLimit));
-  ASSERT_NE(fuse, nullptr);
-  StatusListener listener(ListenerUrl(7813));
-  pi::LcmBus bus(url);
+  InjectedFuse run(dir, 7813, "--idle-exit 3 --max-message-bytes " + std::to_string(kLimit));
+  ASSERT_NE(run.fuse, nullptr);
   constexpr int kInjectedFrames = 6, kPoints = 400, kBadPerFrame = 4, kBadGnss = 2;
   for (int k = 0; k < kInjectedFrames; ++k) {
     const std::int64_t stamp = (k + 1) * 100000000LL;
@@ -447,36 +454,36 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
     // on another rig's channel, and one too large.
     std::vector<std::uint8_t> noise(64);
     for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<std::uint8_t>(i * 37 + k);
-    bus.Publish(pi::RigCloudChannel(2), noise);
+    run.bus.Publish(pi::RigCloudChannel(2), noise);
     auto cut = RigCloudMessage(3, stamp, k, 100);
     cut.resize(cut.size() / 2);
-    bus.Publish(pi::RigCloudChannel(3), cut);
-    bus.Publish(pi::RigCloudChannel(4), RigCloudMessage(1, stamp, k, 100));
+    run.bus.Publish(pi::RigCloudChannel(3), cut);
+    run.bus.Publish(pi::RigCloudChannel(4), RigCloudMessage(1, stamp, k, 100));
     const auto oversized = RigCloudMessage(0, stamp, k, 30000);
     ASSERT_GT(oversized.size(), kLimit);
-    bus.Publish(pi::RigCloudChannel(0), oversized);
+    run.bus.Publish(pi::RigCloudChannel(0), oversized);
     if (k == 0) {
       // GNSS: random bytes, and a fix said valid at latitude 200 deg.
-      bus.Publish(drivers::kGnssChannel, noise);
+      run.bus.Publish(drivers::kGnssChannel, noise);
       drivers::GnssFix impossible;
       impossible.stamp_ns = stamp;
       impossible.latitude_deg = 200.0;
       impossible.valid = true;
-      bus.Publish(drivers::kGnssChannel, drivers::EncodeGnssMessage(impossible));
+      run.bus.Publish(drivers::kGnssChannel, drivers::EncodeGnssMessage(impossible));
     }
-    for (int rig = 0; rig < kRigs; ++rig) bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints));
+    for (int rig = 0; rig < kRigs; ++rig) run.bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints));
     // No lock-step with fuse: the bursts come as fast as this thread can send them.
   }
   // Two more after the last frame: counted in a status of their own if the last frame is fused
   // before they arrive.
-  bus.Publish(pi::RigCloudChannel(2), std::vector<std::uint8_t>(16, 0xff));
-  bus.Publish(pi::RigCloudChannel(0), RigCloudMessage(0, (kInjectedFrames + 1) * 100000000LL, kInjectedFrames, 30000));
+  run.bus.Publish(pi::RigCloudChannel(2), std::vector<std::uint8_t>(16, 0xff));
+  run.bus.Publish(pi::RigCloudChannel(0), RigCloudMessage(0, (kInjectedFrames + 1) * 100000000LL, kInjectedFrames, 30000));
   constexpr int kTrailing = 2;
   // fuse ends by itself once the bus is idle (--idle-exit): it kept running through all of it.
-  const int status = fuse->Wait(60.0);
+  const int status = run.fuse->Wait(60.0);
   ASSERT_TRUE(ExitedCleanly(status)) << test::ReadFile(dir / "fuse.err");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last status on its way
-  auto statuses = listener.statuses();
+  auto statuses = run.listener.statuses();
   ASSERT_GE(statuses.size(), static_cast<std::size_t>(kInjectedFrames)) << test::ReadFile(dir / "fuse.err");
   ASSERT_LE(statuses.size(), static_cast<std::size_t>(kInjectedFrames + 1));
   const pi::PerceptionStatus last = statuses.back();
@@ -495,7 +502,7 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
   EXPECT_EQ(last.malformed_messages, injected);
   // Each kind rejected with its reason, once per frame.
   int oversized = 0, undecodable2 = 0, cut3 = 0, wrong_channel4 = 0, bad_gnss = 0, impossible_fix = 0;
-  for (const auto& e : listener.events()) {
+  for (const auto& e : run.listener.events()) {
     bad_gnss += e.find("malformed message on ROMO_GNSS: ") != std::string::npos;
     impossible_fix += e.find("gnss_fix_t is not a position: latitude 200 deg") != std::string::npos;
     oversized += e.find("oversized message on ROMO_RIG_CLOUD0") != std::string::npos &&
@@ -514,7 +521,7 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
   EXPECT_NE(summary.find("\"malformed_messages\": " + std::to_string(injected)), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"frames_with_missing_rigs\": 0"), std::string::npos) << summary;
-  for (const auto& e : listener.events()) {
+  for (const auto& e : run.listener.events()) {
     if (e.find("malformed") != std::string::npos || e.find("oversized") != std::string::npos) {
       std::printf("event: %s\n", e.c_str());
     }
@@ -522,7 +529,7 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
   std::printf("FIGURE lcm_injection: %d frames x %d rigs delivered whole; %d malformed/oversized messages "
               "injected (%d after the last frame), %lld counted; %zu statuses\n",
               kInjectedFrames, kRigs, injected, kTrailing, static_cast<long long>(last.malformed_messages),
-              listener.statuses().size());
+              run.listener.statuses().size());
 }
 
 // Fuse's defaults depend on the workers' image size (full-resolution images take L-shape
@@ -530,20 +537,17 @@ TEST_F(WorkersFuseHilTest, MalformedAndOversizedMessagesAreCountedAndFuseKeepsEv
 // another size is reported, once, while its clouds are still fused.
 TEST_F(WorkersFuseHilTest, FuseTakesItsDefaultsForTheImageSizeTheWorkersSay) {
   test::ScratchDir dir;
-  const std::string url = LcmUrl(7814);
-  auto fuse = StartFuse(dir, url, "--idle-exit 2");
-  ASSERT_NE(fuse, nullptr);
-  StatusListener listener(ListenerUrl(7814));
-  pi::LcmBus bus(url);
+  InjectedFuse run(dir, 7814, "--idle-exit 2");
+  ASSERT_NE(run.fuse, nullptr);
   constexpr int kSentFrames = 3, kPoints = 300, kFullWidthPx = 782, kOddRig = 5;
   for (int k = 0; k < kSentFrames; ++k) {
     const std::int64_t stamp = (k + 1) * 100000000LL;
     for (int rig = 0; rig < kRigs; ++rig) {
       const int width = rig == kOddRig ? kRecordingWidthPx : kFullWidthPx;
-      bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints, width));
+      run.bus.Publish(pi::RigCloudChannel(rig), RigCloudMessage(rig, stamp, k, kPoints, width));
     }
   }
-  ASSERT_TRUE(ExitedCleanly(fuse->Wait(60.0))) << test::ReadFile(dir / "fuse.err");
+  ASSERT_TRUE(ExitedCleanly(run.fuse->Wait(60.0))) << test::ReadFile(dir / "fuse.err");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last status on its way
   const std::string err = test::ReadFile(dir / "fuse.err");
   EXPECT_NE(err.find("defaults for " + std::to_string(kFullWidthPx) + "-px images (rig 0's first cloud)"),
@@ -551,13 +555,13 @@ TEST_F(WorkersFuseHilTest, FuseTakesItsDefaultsForTheImageSizeTheWorkersSay) {
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
   EXPECT_NE(summary.find("\"image_width_px\": " + std::to_string(kFullWidthPx)), std::string::npos) << summary;
   int odd_size_reports = 0;
-  for (const auto& e : listener.events()) {
+  for (const auto& e : run.listener.events()) {
     odd_size_reports += e.find("rig " + std::to_string(kOddRig) + " sends clouds of " +
                                std::to_string(kRecordingWidthPx) + "-px images; fuse took its defaults for " +
                                std::to_string(kFullWidthPx) + " px") != std::string::npos;
   }
   EXPECT_EQ(odd_size_reports, 1);
-  const auto statuses = listener.statuses();
+  const auto statuses = run.listener.statuses();
   ASSERT_GE(statuses.size(), static_cast<std::size_t>(kSentFrames));
   for (int k = 0; k < kSentFrames; ++k) {
     EXPECT_EQ(PresentRigs(statuses[static_cast<std::size_t>(k)]), kRigs) << "frame " << k;

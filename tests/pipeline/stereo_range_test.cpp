@@ -9,8 +9,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <opencv2/calib3d.hpp>
 
+#include "camera_projection.hpp"
 #include "romo/drivers/uri.hpp"
 #include "romo/pipeline/pipeline.hpp"
 #include "romo/sim/sim_source.hpp"
@@ -18,18 +18,6 @@
 
 namespace romo::pipeline {
 namespace {
-
-cv::Point2d Project(const Eigen::Vector3d& p_cam, const drivers::CameraIntrinsics& cam) {
-  cv::Mat K(3, 3, CV_64F), dist(1, static_cast<int>(cam.distortion.size()), CV_64F);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = cam.K(r, c);
-  }
-  for (std::size_t i = 0; i < cam.distortion.size(); ++i) dist.at<double>(0, static_cast<int>(i)) = cam.distortion[i];
-  std::vector<cv::Point3d> in = {{p_cam.x(), p_cam.y(), p_cam.z()}};
-  std::vector<cv::Point2d> out;
-  cv::projectPoints(in, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, cam.distortion.empty() ? cv::Mat() : dist, out);
-  return out[0];
-}
 
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -67,7 +55,7 @@ RangeErrors Measure(int refine_radius_px) {
       for (std::size_t i = 0; i < in->cloud.size(); ++i) {
         const Eigen::Vector3d p = T_rig_vehicle * in->cloud.xyz.col(static_cast<Eigen::Index>(i)).cast<double>();
         if (p.z() < 1.0) continue;
-        const cv::Point2d uv = Project(p, rig.left);
+        const cv::Point2d uv = test::ProjectToImage(p, rig.left);
         const int u = static_cast<int>(std::lround(uv.x)), v = static_cast<int>(std::lround(uv.y));
         if (u < 1 || v < 1 || u + 1 >= depth->width || v + 1 >= depth->height) continue;
         const std::size_t centre = static_cast<std::size_t>(v) * depth->width + u;

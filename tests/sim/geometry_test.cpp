@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
+#include "camera_projection.hpp"
 #include "romo/sim/sim_source.hpp"
 
 namespace romo::sim {
@@ -49,19 +50,6 @@ Sample SampleDisparity(const std::vector<float>& depth, const std::vector<std::i
   s.gradient_v = 0.5 * (d(x0, y0 + 2) - d(x0, y0 - 1)) / 1.5;
   s.ok = true;
   return s;
-}
-
-cv::Point2d Project(const Eigen::Vector3d& p_cam, const drivers::CameraIntrinsics& cam) {
-  cv::Mat K(3, 3, CV_64F), dist(1, static_cast<int>(cam.distortion.size()), CV_64F);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = cam.K(r, c);
-  }
-  for (std::size_t i = 0; i < cam.distortion.size(); ++i) dist.at<double>(0, static_cast<int>(i)) = cam.distortion[i];
-  std::vector<cv::Point3d> in = {{p_cam.x(), p_cam.y(), p_cam.z()}};
-  std::vector<cv::Point2d> out;
-  cv::projectPoints(in, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
-                    cam.distortion.empty() ? cv::Mat() : dist, out);
-  return out[0];
 }
 
 struct TruthPoint {
@@ -128,7 +116,7 @@ void CheckRig(const drivers::RigCalibration& rig, const GtDepth& depth, const Gr
         tp.normal_world.dot((right_centre - tp.p_world).normalized()) <= min_cos) {
       continue;
     }
-    const cv::Point2d ul = Project(pl, rig.left), ur = Project(pr, rig.right);
+    const cv::Point2d ul = test::ProjectToImage(pl, rig.left), ur = test::ProjectToImage(pr, rig.right);
     const Sample sl = SampleDisparity(depth.left_depth_m, depth.left_object_id, depth.width,
                                       depth.height, ul.x, ul.y, id, fb);
     const Sample sr = SampleDisparity(depth.right_depth_m, depth.right_object_id, depth.width,
