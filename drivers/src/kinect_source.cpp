@@ -103,8 +103,8 @@ class KinectSource : public FrameSource {
   std::optional<FrameSet> Next() override {
     const auto timeout = counters_.completed == 0 ? kFirstFrameTimeout : kFrameTimeout;
     std::unique_lock<std::mutex> lock(mutex_);
-    const bool arrived = frame_ready_.wait_for(lock, timeout, [this] { return (new_rgb_ && new_depth_) || ended_; });
-    if (!arrived || !(new_rgb_ && new_depth_)) {
+    frame_ready_.wait_for(lock, timeout, [this] { return (new_rgb_ && new_depth_) || ended_; });
+    if (!(new_rgb_ && new_depth_)) {
       // An unplugged device or the end of a fakenect replay: the stream ends, reported.
       if (events_.empty()) {
         events_.push_back("kinect " + std::to_string(index_) + " stopped after " + std::to_string(counters_.completed) +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <opencv2/calib3d.hpp>
@@ -257,63 +258,71 @@ void MedianFilterValid(cv::Mat* disparity, int invalid_disparity) {
   }
 }
 
+namespace {
+
+// The rectified pair as float intensities and their x-gradients (central differences).
+struct GradientPair {
+  cv::Mat left, right, left_dx, right_dx;
+};
+
+// One Gauss-Newton step of disparity @p d at (@p x, @p y): the zero-mean intensity difference
+// between the left window and the right one shifted by d, over the gradient averaged over both.
+// nullopt where the window leaves the right image or lacks x-texture.
+std::optional<double> LucasKanadeStep(const GradientPair& p, int x, int y, int radius, double d) {
+  const int n = (2 * radius + 1) * (2 * radius + 1);
+  // Below ~1 grey level of x-gradient per pixel the step is noise.
+  const double min_gradient_variance = 1.0 * n;
+  double sg = 0, se = 0, sgg = 0, sge = 0;
+  for (int v = y - radius; v <= y + radius; ++v) {
+    const float* l = p.left.ptr<float>(v);
+    const float* ldx = p.left_dx.ptr<float>(v);
+    const float* r = p.right.ptr<float>(v);
+    const float* rdx = p.right_dx.ptr<float>(v);
+    for (int u = x - radius; u <= x + radius; ++u) {
+      const double xr = u - d;
+      const int x0 = static_cast<int>(std::floor(xr));
+      if (x0 < 1 || x0 + 2 >= p.right.cols) return std::nullopt;
+      const double a = xr - x0;
+      const double g = 0.5 * (ldx[u] + (1 - a) * rdx[x0] + a * rdx[x0 + 1]);
+      const double e = (1 - a) * r[x0] + a * r[x0 + 1] - l[u];
+      sg += g;
+      se += e;
+      sgg += g * g;
+      sge += g * e;
+    }
+  }
+  const double var_g = sgg - sg * sg / n;
+  if (var_g < min_gradient_variance) return std::nullopt;
+  return (sge - sg * se / n) / var_g;
+}
+
+}  // namespace
+
 void RefineDisparityByGradient(const cv::Mat& left8, const cv::Mat& right8, int radius, int subpixel_scale,
                                int invalid_disparity, cv::Mat* disparity) {
   ROMO_THROW_UNLESS(disparity != nullptr && disparity->type() == CV_16SC1);
   ROMO_THROW_UNLESS(left8.type() == CV_8UC1 && right8.type() == CV_8UC1 && left8.size() == right8.size() &&
                     left8.size() == disparity->size());
   ROMO_THROW_UNLESS(radius >= 1 && subpixel_scale > 0);
-  const int rows = left8.rows, cols = left8.cols;
-  cv::Mat left, right, left_dx, right_dx;
-  left8.convertTo(left, CV_32F);
-  right8.convertTo(right, CV_32F);
-  // Central differences (scale 1/2 per pixel).
-  cv::Sobel(left, left_dx, CV_32F, 1, 0, 1, 0.5);
-  cv::Sobel(right, right_dx, CV_32F, 1, 0, 1, 0.5);
-  const float scale = static_cast<float>(subpixel_scale);
-  const int n = (2 * radius + 1) * (2 * radius + 1);
-  // Below ~1 grey level of x-gradient per pixel the step is noise.
-  const double min_gradient_variance = 1.0 * n;
-  for (int y = radius; y < rows - radius; ++y) {
+  GradientPair pair;
+  left8.convertTo(pair.left, CV_32F);
+  right8.convertTo(pair.right, CV_32F);
+  cv::Sobel(pair.left, pair.left_dx, CV_32F, 1, 0, 1, 0.5);
+  cv::Sobel(pair.right, pair.right_dx, CV_32F, 1, 0, 1, 0.5);
+  const double scale = subpixel_scale;
+  constexpr int kSteps = 2;
+  for (int y = radius; y < left8.rows - radius; ++y) {
     short* out = disparity->ptr<short>(y);
-    for (int x = radius; x < cols - radius; ++x) {
+    for (int x = radius; x < left8.cols - radius; ++x) {
       if (out[x] <= invalid_disparity) continue;
       const double d0 = out[x] / scale;
-      double d = d0;
-      bool ok = true;
-      for (int iteration = 0; iteration < 2 && ok; ++iteration) {
-        double sg = 0, se = 0, sgg = 0, sge = 0;
-        for (int v = y - radius; v <= y + radius && ok; ++v) {
-          const float* l = left.ptr<float>(v);
-          const float* ldx = left_dx.ptr<float>(v);
-          const float* r = right.ptr<float>(v);
-          const float* rdx = right_dx.ptr<float>(v);
-          for (int u = x - radius; u <= x + radius; ++u) {
-            const double xr = u - d;
-            const int x0 = static_cast<int>(std::floor(xr));
-            if (x0 < 1 || x0 + 2 >= cols) {
-              ok = false;
-              break;
-            }
-            const double a = xr - x0;
-            const double rv = (1 - a) * r[x0] + a * r[x0 + 1];
-            const double g = 0.5 * (ldx[u] + (1 - a) * rdx[x0] + a * rdx[x0 + 1]);
-            const double e = rv - l[u];
-            sg += g;
-            se += e;
-            sgg += g * g;
-            sge += g * e;
-          }
-        }
-        if (!ok) break;
-        const double var_g = sgg - sg * sg / n;
-        if (var_g < min_gradient_variance) {
-          ok = false;
-          break;
-        }
-        d += (sge - sg * se / n) / var_g;
+      std::optional<double> d = d0;
+      for (int step = 0; step < kSteps && d; ++step) {
+        const std::optional<double> delta = LucasKanadeStep(pair, x, y, radius, *d);
+        d = delta ? std::optional<double>(*d + *delta) : std::nullopt;
       }
-      if (ok && std::abs(d - d0) < 1.0) out[x] = static_cast<short>(std::lround(d * scale));
+      // A step of a pixel or more crossed a depth edge: keep the matcher's value.
+      if (d && std::abs(*d - d0) < 1.0) out[x] = static_cast<short>(std::lround(*d * scale));
     }
   }
 }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "camera_projection.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/drivers/uri.hpp"
 #include "romo/pipeline/pipeline.hpp"
 #include "romo/sim/sim_source.hpp"
@@ -18,11 +19,6 @@
 
 namespace romo::pipeline {
 namespace {
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 struct RangeErrors {
   std::map<int, std::vector<double>> depth_by_band;     // stereo z - true z, by 2 m band of true z

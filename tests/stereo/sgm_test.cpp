@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/stereo/synthetic.hpp"
 
 namespace romo::stereo {
@@ -115,11 +116,9 @@ std::vector<double> MedianErrorByTrueFraction(int refine_radius_px) {
     }
   }
   std::vector<double> medians;
-  for (auto& e : errors) {
+  for (const auto& e : errors) {
     EXPECT_GT(e.size(), 100u) << "the plane must cover every fraction";
-    if (e.empty()) continue;
-    std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-    medians.push_back(e[e.size() / 2]);
+    if (!e.empty()) medians.push_back(Median(e));
   }
   return medians;
 }
