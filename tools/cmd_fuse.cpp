@@ -308,8 +308,11 @@ void Fuse(const FuseOptions& o) {
                    rc->rig_id);
     } else if (rc->image_width_px > 0 && rc->image_width_px != pipe.image_width_px() &&
                mismatched_width_rigs.insert(rc->rig_id).second) {
+      const std::string taken = pipe.image_width_px() > 0
+                                    ? "its defaults for " + std::to_string(pipe.image_width_px()) + " px"
+                                    : "its fallback defaults (the first cloud did not say its image width)";
       pipe.ReportEvent("rig " + std::to_string(rc->rig_id) + " sends clouds of " + std::to_string(rc->image_width_px) +
-                       "-px images; fuse took its defaults for " + std::to_string(pipe.image_width_px()) + " px");
+                       "-px images; fuse took " + taken);
     }
     std::int64_t& newest = newest_stamp[rc->rig_id];
     newest = std::max(newest, rc->stamp_ns);

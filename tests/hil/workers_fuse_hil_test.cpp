@@ -187,6 +187,14 @@ constexpr double kMaxGapYawDifferenceRad = 0.3;
 constexpr int kMaxGapPresenceDifferences = 10;  // measured 6 (of 46 listed)
 constexpr double kSlotMatchM = 1.0;  // a slot's target this near is the same bay (bays are >= 2.5 m apart)
 
+// Events on the bus holding @p text.
+template <typename Listener>
+int CountEvents(const Listener& listener, const std::string& text) {
+  int n = 0;
+  for (const auto& e : listener.events()) n += e.find(text) != std::string::npos;
+  return n;
+}
+
 TEST_F(WorkersFuseHilTest, SixWorkersAndFuseMatchTheSingleProcess) {
   test::ScratchDir dir;
   const auto started = Clock::now();
@@ -554,18 +562,40 @@ TEST_F(WorkersFuseHilTest, FuseTakesItsDefaultsForTheImageSizeTheWorkersSay) {
             std::string::npos) << err;
   const std::string summary = test::ReadFile(dir / "fuse/summary.json");
   EXPECT_NE(summary.find("\"image_width_px\": " + std::to_string(kFullWidthPx)), std::string::npos) << summary;
-  int odd_size_reports = 0;
-  for (const auto& e : run.listener.events()) {
-    odd_size_reports += e.find("rig " + std::to_string(kOddRig) + " sends clouds of " +
-                               std::to_string(kRecordingWidthPx) + "-px images; fuse took its defaults for " +
-                               std::to_string(kFullWidthPx) + " px") != std::string::npos;
-  }
-  EXPECT_EQ(odd_size_reports, 1);
+  EXPECT_EQ(CountEvents(run.listener, "rig " + std::to_string(kOddRig) + " sends clouds of " +
+                                          std::to_string(kRecordingWidthPx) + "-px images; fuse took its defaults for " +
+                                          std::to_string(kFullWidthPx) + " px"),
+            1);
   const auto statuses = run.listener.statuses();
   ASSERT_GE(statuses.size(), static_cast<std::size_t>(kSentFrames));
   for (int k = 0; k < kSentFrames; ++k) {
     EXPECT_EQ(PresentRigs(statuses[static_cast<std::size_t>(k)]), kRigs) << "frame " << k;
   }
+}
+
+// An older worker says no image size (0): fuse keeps its fallback defaults, and the rigs that do
+// say one are told apart from a real size mismatch.
+TEST_F(WorkersFuseHilTest, FuseSaysWhenTheFirstCloudDidNotSayItsImageSize) {
+  test::ScratchDir dir;
+  InjectedFuse run(dir, 7815, "--idle-exit 2");
+  ASSERT_NE(run.fuse, nullptr);
+  constexpr int kSentFrames = 2, kPoints = 300, kFullWidthPx = 782;
+  for (int k = 0; k < kSentFrames; ++k) {
+    for (int rig = 0; rig < kRigs; ++rig) {
+      run.bus.Publish(pi::RigCloudChannel(rig),
+                      RigCloudMessage(rig, (k + 1) * 100000000LL, k, kPoints, rig == 0 ? 0 : kFullWidthPx));
+    }
+  }
+  ASSERT_TRUE(ExitedCleanly(run.fuse->Wait(60.0))) << test::ReadFile(dir / "fuse.err");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const std::string err = test::ReadFile(dir / "fuse.err");
+  EXPECT_NE(err.find("defaults for an image size the workers do not say (rig 0's first cloud)"), std::string::npos)
+      << err;
+  EXPECT_NE(test::ReadFile(dir / "fuse/summary.json").find("\"image_width_px\": 0"), std::string::npos);
+  // Once per rig that says a size, never "defaults for 0 px".
+  EXPECT_EQ(CountEvents(run.listener, "-px images; fuse took its fallback defaults (the first cloud did not say"),
+            kRigs - 1);
+  EXPECT_EQ(CountEvents(run.listener, "defaults for 0 px"), 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -718,6 +719,16 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   const auto json = romo::test::RunRomo("eval scene --json --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(json.exit_code, 0) << json.err;
   EXPECT_NE(json.out.find("\"frames\":2"), std::string::npos) << json.out;
+  // The counts behind each ratio, so that runs over several seeds pool: recall = matched / truths.
+  const std::regex car_counts(R"("car":\{"precision":([0-9.e-]+), "recall":([0-9.e-]+), [^}]*"truths":(\d+), )"
+                              R"("matched_truths":(\d+), "detections":(\d+), "matched_detections":(\d+)\})");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(json.out, m, car_counts)) << json.out;
+  const double truths = std::stod(m[3]), matched = std::stod(m[4]);
+  const double detections = std::stod(m[5]), matched_detections = std::stod(m[6]);
+  ASSERT_GT(truths, 0) << json.out;
+  EXPECT_NEAR(std::stod(m[2]), matched / truths, 1e-3) << json.out;  // printed to 4 digits
+  if (detections > 0) EXPECT_NEAR(std::stod(m[1]), matched_detections / detections, 1e-3) << json.out;
   // --misses: after the summary, one line per missed or false sighting, each naming its frame.
   const auto misses = romo::test::RunRomo("eval scene --misses --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(misses.exit_code, 0) << misses.err;

@@ -20,8 +20,6 @@ namespace romo::pipeline {
 namespace pi = planning_iface;
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Frame {
   std::optional<sim::GroundTruth> truth;
   std::optional<pi::ObstacleList> obstacles;
@@ -305,23 +303,33 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   return out;
 }
 
+namespace {
+// Counts as well as ratios, so that runs over several seeds can be pooled.
+std::string ClassJson(const ClassScore& score, bool with_center) {
+  std::ostringstream js;
+  js.precision(4);
+  js << "{\"precision\":" << score.precision() << ", \"recall\":" << score.recall();
+  if (with_center) js << ", \"center_err_m_median\":" << score.center_err_m_median;
+  js << ", \"truths\":" << score.truths << ", \"matched_truths\":" << score.matched_truths
+     << ", \"detections\":" << score.detections << ", \"matched_detections\":" << score.matched_detections << "}";
+  return js.str();
+}
+}  // namespace
+
 std::string SceneEval::ToJson() const {
   std::ostringstream js;
   js.precision(4);
-  js << "{\"frames\":" << frames << ", \"car\":{\"precision\":" << car.precision()
-     << ", \"recall\":" << car.recall() << ", \"center_err_m_median\":" << car.center_err_m_median
-     << "}, \"pedestrian\":{\"precision\":" << pedestrian.precision() << ", \"recall\":" << pedestrian.recall()
-     << ", \"center_err_m_median\":" << pedestrian.center_err_m_median
-     << "}, \"box_center_err_m_median\":" << box_center_err_m_median
+  js << "{\"frames\":" << frames << ", \"car\":" << ClassJson(car, true)
+     << ", \"pedestrian\":" << ClassJson(pedestrian, true)
+     << ", \"box_center_err_m_median\":" << box_center_err_m_median
      << ", \"box_size_err_m_median\":" << box_size_err_m_median
      << ", \"car_yaw_err_deg_median\":" << car_yaw_err_deg_median << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
      << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
      << ", \"center_err_m\":" << slot_center_err_m << ", \"yaw_err_deg\":" << slot_yaw_err_deg
      << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}";
   if (visibility_scored) {
-    js << ", \"car_visible\":{\"precision\":" << car_visible.precision() << ", \"recall\":" << car_visible.recall()
-       << "}, \"pedestrian_visible\":{\"precision\":" << pedestrian_visible.precision()
-       << ", \"recall\":" << pedestrian_visible.recall() << "}";
+    js << ", \"car_visible\":" << ClassJson(car_visible, false)
+       << ", \"pedestrian_visible\":" << ClassJson(pedestrian_visible, false);
   }
   js << "}";
   return js.str();
