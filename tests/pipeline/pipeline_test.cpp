@@ -2,6 +2,7 @@
 #include "romo/pipeline/pipeline.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -13,6 +14,7 @@
 #include "romo/core/check.hpp"
 #include "romo/drivers/calibration.hpp"
 #include "romo/drivers/recording.hpp"
+#include "romo/pipeline/scene_eval.hpp"
 #include "romo/planning_iface/messages.hpp"
 #include "test_support.hpp"
 
@@ -728,7 +730,9 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   const double detections = std::stod(m[5]), matched_detections = std::stod(m[6]);
   ASSERT_GT(truths, 0) << json.out;
   EXPECT_NEAR(std::stod(m[2]), matched / truths, 1e-3) << json.out;  // printed to 4 digits
-  if (detections > 0) EXPECT_NEAR(std::stod(m[1]), matched_detections / detections, 1e-3) << json.out;
+  if (detections > 0) {
+    EXPECT_NEAR(std::stod(m[1]), matched_detections / detections, 1e-3) << json.out;
+  }
   // --misses: after the summary, one line per missed or false sighting, each naming its frame.
   const auto misses = romo::test::RunRomo("eval scene --misses --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(misses.exit_code, 0) << misses.err;
@@ -744,6 +748,52 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   romo::test::WriteFile(dir / "empty.lcmlog", "");
   const auto bad = romo::test::RunRomo("replay " + (dir / "empty.lcmlog") + " --out " + (dir / "x"));
   EXPECT_NE(bad.exit_code, 0);
+}
+
+// Several runs (seeds) scored as one: what each run counts adds up, and the lists name the run.
+TEST(PipelineTest, EvalScenePoolsSeveralRuns) {
+  romo::test::ScratchDir dir;
+  std::vector<std::string> logs;
+  for (int seed : {1, 2}) {
+    const std::string out = dir / ("seed" + std::to_string(seed));
+    const auto res = romo::test::RunRomo("run --frames 2 --scale 0.25 --no-pictures --lcm-url \"\" --seed " +
+                                         std::to_string(seed) + " --out " + out);
+    ASSERT_EQ(res.exit_code, 0) << res.err;
+    logs.push_back(out + "/outputs.lcmlog");
+  }
+  const SceneEval one = EvaluateSceneLog(logs[0]), two = EvaluateSceneLog(logs[1]);
+  const SceneEval pooled = EvaluateSceneLogs(logs);
+  EXPECT_EQ(pooled.logs, 2);
+  EXPECT_EQ(pooled.frames, one.frames + two.frames);
+  EXPECT_EQ(pooled.id_switches, one.id_switches + two.id_switches);
+  const std::array<const ClassScore*, 3> scores[] = {{&pooled.car, &one.car, &two.car},
+                                                     {&pooled.pedestrian, &one.pedestrian, &two.pedestrian},
+                                                     {&pooled.car_visible, &one.car_visible, &two.car_visible}};
+  for (const auto& [sum, first, second] : scores) {
+    EXPECT_EQ(sum->truths, first->truths + second->truths);
+    EXPECT_EQ(sum->matched_truths, first->matched_truths + second->matched_truths);
+    EXPECT_EQ(sum->detections, first->detections + second->detections);
+  }
+  EXPECT_EQ(pooled.slot_visible_frames, one.slot_visible_frames + two.slot_visible_frames);
+  ASSERT_TRUE(pooled.visibility_scored);
+  EXPECT_EQ(pooled.misses.size(), one.misses.size() + two.misses.size());
+  EXPECT_EQ(pooled.false_alarms.size(), one.false_alarms.size() + two.false_alarms.size());
+  for (const SceneMiss& m : pooled.misses) EXPECT_TRUE(m.log == 0 || m.log == 1);
+  // The CLI takes the logs as repeated --log; its lists say which run a line is from.
+  const auto cli = romo::test::RunRomo("eval scene --json --log " + logs[0] + " --log " + logs[1]);
+  ASSERT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_NE(cli.out.find("\"logs\":2"), std::string::npos) << cli.out;
+  EXPECT_NE(cli.out.find("\"truths\":" + std::to_string(pooled.car.truths) + ","), std::string::npos) << cli.out;
+  const auto listed = romo::test::RunRomo("eval scene --misses --log " + logs[0] + " " + logs[1]);
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_NE(listed.out.find("frames scored: " + std::to_string(pooled.frames) + " in 2 logs"), std::string::npos);
+  if (!pooled.misses.empty()) {
+    EXPECT_NE(listed.out.find("\nlog 0 frame "), std::string::npos) << listed.out;
+  }
+  // A log that is not there is named.
+  const auto missing = romo::test::RunRomo("eval scene --log " + logs[0] + " --log " + (dir / "none.lcmlog"));
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("none.lcmlog"), std::string::npos) << missing.err;
 }
 
 // A recording cut inside its last frame set (power lost while writing): replay processes every

@@ -54,10 +54,11 @@ double HeadingIn(const Eigen::Isometry3d& T_to, double yaw_rad) {
   return std::atan2(heading.y(), heading.x());
 }
 
-SceneMiss DescribeMiss(std::int64_t frame, const std::string& cls, int id, const Eigen::Vector2d& at,
+SceneMiss DescribeMiss(int log, std::int64_t frame, const std::string& cls, int id, const Eigen::Vector2d& at,
                        double yaw_rad, double visible_fraction, const std::vector<pi::Obstacle>& obstacles) {
   constexpr double kNearestWithinM = 3.0;
   SceneMiss miss;
+  miss.log = log;
   miss.frame = frame;
   miss.class_name = cls;
   miss.truth_id = id;
@@ -80,9 +81,10 @@ SceneMiss DescribeMiss(std::int64_t frame, const std::string& cls, int id, const
   return miss;
 }
 
-SceneFalseAlarm DescribeFalseAlarm(std::int64_t frame, const std::string& cls, const pi::Obstacle& d,
+SceneFalseAlarm DescribeFalseAlarm(int log, std::int64_t frame, const std::string& cls, const pi::Obstacle& d,
                                    const std::vector<sim::GtBox>& truths, const Eigen::Isometry3d& T_vw) {
   SceneFalseAlarm alarm;
+  alarm.log = log;
   alarm.frame = frame;
   alarm.class_name = cls;
   alarm.x_m = d.center_m.x();
@@ -111,7 +113,26 @@ SceneFalseAlarm DescribeFalseAlarm(std::int64_t frame, const std::string& cls, c
 
 }  // namespace
 
-SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
+namespace {
+
+// Scores logs one after the other into pooled counts and error lists.
+class Scorer {
+ public:
+  explicit Scorer(const SceneEvalParams& params) : params_(params) {}
+  void Add(const std::string& log_path, int log_index);
+  SceneEval Finish();
+
+ private:
+  const SceneEvalParams& params_;
+  SceneEval out_;
+  int calibrated_logs_ = 0;
+  std::vector<double> center_errors_, size_errors_, car_yaw_errors_, slot_center_, slot_yaw_;
+  std::vector<double> car_center_errors_, pedestrian_center_errors_, ade_list_, fde_list_;
+};
+
+void Scorer::Add(const std::string& log_path, int log_index) {
+  const SceneEvalParams& params = params_;
+  SceneEval& out = out_;
   std::int64_t truncated = -1;
   const auto events = drivers::ReadAllEvents(log_path, &truncated);
   std::map<std::int64_t, Frame> frames;  // by stamp_ns
@@ -136,11 +157,9 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
       if (!preds.empty()) frames[preds.front().stamp_ns].predictions = std::move(preds);
     }
   }
-  SceneEval out;
-  std::vector<double> center_errors, size_errors, car_yaw_errors, slot_center, slot_yaw;
-  std::vector<double> car_center_errors, pedestrian_center_errors;
-  objects::IdSwitchCounter switches(params.car_match_m);
-  std::vector<double> ade_list, fde_list;
+  const std::int64_t frames_before = out.frames;
+  calibrated_logs_ += calibration.has_value();
+  objects::IdSwitchCounter switches(params.car_match_m);  // track ids are per run
   // Truth positions of pedestrians over time for prediction scoring (world frame).
   std::map<int, std::map<std::int64_t, Eigen::Vector2d>> ped_truth;
   for (const auto& [stamp, f] : frames) {
@@ -152,6 +171,7 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
   for (const auto& [stamp, f] : frames) {
     if (!f.truth || !f.obstacles) continue;
     ++out.frames;
+    const std::int64_t frame_index = out.frames - 1 - frames_before;  // within this log
     const Eigen::Isometry3d& T_wv = f.truth->T_world_vehicle;
     const Eigen::Isometry3d T_vw = T_wv.inverse();
     std::vector<objects::IdPosition> gt_ids, track_ids;
@@ -198,23 +218,23 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
         for (const auto& [i, j] : m) matched[i] = used[j] = true;
         for (std::size_t j = 0; j < det.size(); ++j) {
           if (used[j]) continue;
-          out.false_alarms.push_back(DescribeFalseAlarm(out.frames - 1, cls, *det_box[j], f.truth->objects, T_vw));
+          out.false_alarms.push_back(DescribeFalseAlarm(log_index, frame_index, cls, *det_box[j], f.truth->objects, T_vw));
         }
         for (std::size_t i = 0; i < truth.size(); ++i) {
           if (matched[i] || !truth_visible[i]) continue;
-          out.misses.push_back(DescribeMiss(out.frames - 1, cls, truth_id[i], truth[i],
+          out.misses.push_back(DescribeMiss(log_index, frame_index, cls, truth_id[i], truth[i],
                                             HeadingIn(T_vw, truth_box[i]->yaw_rad), truth_visible_fraction[i],
                                             f.obstacles->obstacles));
         }
       }
       for (const auto& [i, j] : m) {
-        center_errors.push_back((truth[i] - det[j]).norm());
-        (cls == "car" ? car_center_errors : pedestrian_center_errors).push_back(center_errors.back());
+        center_errors_.push_back((truth[i] - det[j]).norm());
+        (cls == "car" ? car_center_errors_ : pedestrian_center_errors_).push_back(center_errors_.back());
         const sim::GtBox& t = *truth_box[i];
         const pi::Obstacle& d = *det_box[j];
-        size_errors.push_back((t.size_m - d.size_m).norm());
+        size_errors_.push_back((t.size_m - d.size_m).norm());
         // Cars only: a pedestrian's footprint is too square for a heading.
-        if (cls == "car") car_yaw_errors.push_back(AxisAngleDeg(HeadingIn(T_vw, t.yaw_rad), d.yaw_rad));
+        if (cls == "car") car_yaw_errors_.push_back(AxisAngleDeg(HeadingIn(T_vw, t.yaw_rad), d.yaw_rad));
       }
       for (std::size_t i = 0; i < truth.size(); ++i) gt_ids.push_back({truth_id[i], truth[i]});
       for (std::size_t j = 0; j < det.size(); ++j) {
@@ -253,8 +273,8 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
       if (errs.empty()) continue;
       double sum = 0;
       for (double e : errs) sum += e;
-      ade_list.push_back(sum / errs.size());
-      fde_list.push_back(errs.back());
+      ade_list_.push_back(sum / errs.size());
+      fde_list_.push_back(errs.back());
     }
 
     // Parking: the feasible bays fully visible now, and any narrow bay reported feasible.
@@ -278,32 +298,61 @@ SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& p
         ++out.slot_visible_frames;
         if (found != nullptr && found->feasible) {
           ++out.slot_found_frames;
-          slot_center.push_back(best);
-          slot_yaw.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
+          slot_center_.push_back(best);
+          slot_yaw_.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
         }
       }
     }
   }
-  if (out.frames == 0) {
+  if (out.frames == frames_before) {
     Fail("eval scene: " + log_path + " has no frame with both ground truth (" +
          sim::kGroundTruthChannel + ") and outputs (" + pi::kObstaclesChannel + ")");
   }
-  out.visibility_scored = calibration.has_value();
-  out.box_center_err_m_median = Median(center_errors);
-  out.car.center_err_m_median = Median(car_center_errors);
-  out.pedestrian.center_err_m_median = Median(pedestrian_center_errors);
-  out.box_size_err_m_median = Median(size_errors);
-  out.car_yaw_err_deg_median = Median(car_yaw_errors);
-  out.id_switches = switches.score().id_switches;
-  out.predictions_scored = static_cast<std::int64_t>(ade_list.size());
-  for (double a : ade_list) out.ade_m += a / ade_list.size();
-  for (double a : fde_list) out.fde_m += a / fde_list.size();
-  out.slot_center_err_m = Median(slot_center);
-  out.slot_yaw_err_deg = Median(slot_yaw);
+  ++out.logs;
+  out.id_switches += switches.score().id_switches;
+}
+
+SceneEval Scorer::Finish() {
+  SceneEval out = out_;
+  // Visibility needs every log's calibration: scores over some of the logs would read as all.
+  out.visibility_scored = out.logs > 0 && calibrated_logs_ == out.logs;
+  if (!out.visibility_scored) {
+    out.car_visible = out.pedestrian_visible = ClassScore{};
+    out.misses.clear();
+    out.false_alarms.clear();
+  }
+  out.box_center_err_m_median = Median(center_errors_);
+  out.car.center_err_m_median = Median(car_center_errors_);
+  out.pedestrian.center_err_m_median = Median(pedestrian_center_errors_);
+  out.box_size_err_m_median = Median(size_errors_);
+  out.car_yaw_err_deg_median = Median(car_yaw_errors_);
+  out.predictions_scored = static_cast<std::int64_t>(ade_list_.size());
+  for (double a : ade_list_) out.ade_m += a / ade_list_.size();
+  for (double a : fde_list_) out.fde_m += a / fde_list_.size();
+  out.slot_center_err_m = Median(slot_center_);
+  out.slot_yaw_err_deg = Median(slot_yaw_);
   return out;
 }
 
+}  // namespace
+
+SceneEval EvaluateSceneLogs(const std::vector<std::string>& log_paths, const SceneEvalParams& params) {
+  if (log_paths.empty()) Fail("eval scene: no log given");
+  Scorer scorer(params);
+  for (std::size_t k = 0; k < log_paths.size(); ++k) scorer.Add(log_paths[k], static_cast<int>(k));
+  return scorer.Finish();
+}
+
+SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
+  return EvaluateSceneLogs({log_path}, params);
+}
+
 namespace {
+// "frame N", or "log K frame N" when several logs were pooled.
+std::string Where(std::int64_t logs, int log, std::int64_t frame) {
+  return (logs > 1 ? "log " + std::to_string(log) + " " : std::string()) + "frame " + std::to_string(frame);
+}
+
 // Counts as well as ratios, so that runs over several seeds can be pooled.
 std::string ClassJson(const ClassScore& score, bool with_center) {
   std::ostringstream js;
@@ -319,7 +368,7 @@ std::string ClassJson(const ClassScore& score, bool with_center) {
 std::string SceneEval::ToJson() const {
   std::ostringstream js;
   js.precision(4);
-  js << "{\"frames\":" << frames << ", \"car\":" << ClassJson(car, true)
+  js << "{\"frames\":" << frames << ", \"logs\":" << logs << ", \"car\":" << ClassJson(car, true)
      << ", \"pedestrian\":" << ClassJson(pedestrian, true)
      << ", \"box_center_err_m_median\":" << box_center_err_m_median
      << ", \"box_size_err_m_median\":" << box_size_err_m_median
@@ -338,13 +387,13 @@ std::string SceneEval::ToJson() const {
 std::string SceneEval::ToText() const {
   std::ostringstream t;
   t.precision(3);
-  t << "frames scored: " << frames << "\n"
+  t << "frames scored: " << frames << (logs > 1 ? " in " + std::to_string(logs) + " logs" : std::string()) << "\n"
     << "cars (<= 15 m):        precision " << car.precision() << "  recall " << car.recall() << "  ("
     << car.matched_truths << "/" << car.truths << " found, " << car.detections << " detections)\n"
     << "pedestrians (<= 15 m): precision " << pedestrian.precision() << "  recall " << pedestrian.recall()
     << "  (" << pedestrian.matched_truths << "/" << pedestrian.truths << " found, " << pedestrian.detections
     << " detections)\n"
-    << (visibility_scored ? "" : "(no calibration in the log: objects hidden from the cameras count as misses)\n");
+    << (visibility_scored ? "" : "(no calibration in the log, or in one of the logs: objects hidden from the cameras count as misses)\n");
   if (visibility_scored) {
     t << "visible to the cameras: cars precision " << car_visible.precision() << "  recall " << car_visible.recall()
       << "  (" << car_visible.matched_truths << "/" << car_visible.truths << ");  pedestrians precision "
@@ -366,7 +415,7 @@ std::string SceneEval::MissesText() const {
   std::ostringstream t;
   t.precision(3);
   for (const SceneMiss& m : misses) {
-    t << "frame " << m.frame << " " << m.class_name << " " << m.truth_id << " at (" << m.x_m << ", " << m.y_m
+    t << Where(logs, m.log, m.frame) << " " << m.class_name << " " << m.truth_id << " at (" << m.x_m << ", " << m.y_m
       << ") m, " << 100 * m.visible_fraction << "% visible: ";
     if (m.nearest_class.empty()) {
       t << "nothing within 3 m\n";
@@ -377,7 +426,7 @@ std::string SceneEval::MissesText() const {
     }
   }
   for (const SceneFalseAlarm& a : false_alarms) {
-    t << "frame " << a.frame << " false " << a.class_name << " at (" << a.x_m << ", " << a.y_m << ") m, "
+    t << Where(logs, a.log, a.frame) << " false " << a.class_name << " at (" << a.x_m << ", " << a.y_m << ") m, "
       << a.length_m << " x " << a.width_m << " x " << a.height_m << " m, " << a.points
       << " points: nearest truth " << a.nearest_truth_class << " " << a.nearest_truth_id << " " << a.nearest_truth_m
       << " m away";

@@ -29,7 +29,8 @@ struct ClassScore {
 
 /// A visible truth no detection of its class matched: what was reported nearest to it instead.
 struct SceneMiss {
-  std::int64_t frame = 0;  ///< index among the scored frames
+  int log = 0;             ///< index among the logs scored together
+  std::int64_t frame = 0;  ///< index among the log's scored frames
   std::string class_name;
   int truth_id = -1;
   double x_m = 0.0, y_m = 0.0;  ///< truth centre, vehicle frame
@@ -43,6 +44,7 @@ struct SceneMiss {
 
 /// A car or pedestrian detection no truth of its class matched (among visible truths' frames).
 struct SceneFalseAlarm {
+  int log = 0;
   std::int64_t frame = 0;
   std::string class_name;
   double x_m = 0.0, y_m = 0.0, length_m = 0.0, width_m = 0.0, height_m = 0.0;  ///< vehicle frame
@@ -57,6 +59,7 @@ struct SceneFalseAlarm {
 
 struct SceneEval {
   std::int64_t frames = 0;
+  std::int64_t logs = 0;  ///< runs pooled (counts summed, medians over all matches)
   ClassScore car, pedestrian;  ///< every truth within range
   /// Only truths the cameras can see (needs the calibration in the log: visibility_scored).
   ClassScore car_visible, pedestrian_visible;
@@ -83,5 +86,9 @@ struct SceneEval {
 
 /// @throws romo::Error when the log cannot be read or holds no ground truth frames.
 SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params = {});
+/// Several runs (seeds) scored as one: counts summed, medians over every match, ID switches per
+/// run; the visibility-aware scores only when every log carries its calibration.
+/// @throws romo::Error naming the first log that cannot be read or holds no ground truth frames.
+SceneEval EvaluateSceneLogs(const std::vector<std::string>& log_paths, const SceneEvalParams& params = {});
 
 }  // namespace romo::pipeline
