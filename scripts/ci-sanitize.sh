@@ -16,6 +16,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${ROMO_ASAN_BUILD_DIR:-build-asan-clang}
 fuzz_runs=${ROMO_FUZZ_RUNS:-5000}
+ctest_args=${ROMO_ASAN_CTEST_ARGS--L unit}
 # shellcheck source=sanitizers/env.sh
 source scripts/sanitizers/env.sh
 
@@ -29,11 +30,11 @@ cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 # Only what runs below: the unit suites (with romo, which their CLI tests call) and the fuzzers;
 # the whole suite (ROMO_ASAN_CTEST_ARGS=) needs the whole build.
 targets=(--target romo_unit_tests romo_fuzzers)
-if [ "${ROMO_ASAN_CTEST_ARGS--L unit}" != "-L unit" ]; then targets=(); fi
+if [ "$ctest_args" != "-L unit" ]; then targets=(); fi
 cmake --build "$build_dir" -j "${ROMO_JOBS:-$(nproc)}" "${targets[@]}"
 t1=$(date +%s)
-# shellcheck disable=SC2086  # ROMO_ASAN_CTEST_ARGS is a list of arguments
-ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" ${ROMO_ASAN_CTEST_ARGS--L unit}
+# shellcheck disable=SC2086  # ctest_args is a list of arguments
+ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" $ctest_args
 t2=$(date +%s)
 if [ "$fuzz_runs" -gt 0 ]; then
   ./scripts/fuzz.sh --build-dir "$build_dir" --no-build --runs "$fuzz_runs" --seed 1

@@ -111,10 +111,6 @@ SceneFalseAlarm DescribeFalseAlarm(int log, std::int64_t frame, const std::strin
   return alarm;
 }
 
-}  // namespace
-
-namespace {
-
 // Scores logs one after the other into pooled counts and error lists.
 class Scorer {
  public:
@@ -131,8 +127,6 @@ class Scorer {
 };
 
 void Scorer::Add(const std::string& log_path, int log_index) {
-  const SceneEvalParams& params = params_;
-  SceneEval& out = out_;
   std::int64_t truncated = -1;
   const auto events = drivers::ReadAllEvents(log_path, &truncated);
   std::map<std::int64_t, Frame> frames;  // by stamp_ns
@@ -157,9 +151,9 @@ void Scorer::Add(const std::string& log_path, int log_index) {
       if (!preds.empty()) frames[preds.front().stamp_ns].predictions = std::move(preds);
     }
   }
-  const std::int64_t frames_before = out.frames;
+  const std::int64_t frames_before = out_.frames;
   calibrated_logs_ += calibration.has_value();
-  objects::IdSwitchCounter switches(params.car_match_m);  // track ids are per run
+  objects::IdSwitchCounter switches(params_.car_match_m);  // track ids are per run
   // Truth positions of pedestrians over time for prediction scoring (world frame).
   std::map<int, std::map<std::int64_t, Eigen::Vector2d>> ped_truth;
   for (const auto& [stamp, f] : frames) {
@@ -170,8 +164,8 @@ void Scorer::Add(const std::string& log_path, int log_index) {
   }
   for (const auto& [stamp, f] : frames) {
     if (!f.truth || !f.obstacles) continue;
-    ++out.frames;
-    const std::int64_t frame_index = out.frames - 1 - frames_before;  // within this log
+    ++out_.frames;
+    const std::int64_t frame_index = out_.frames - 1 - frames_before;  // within this log
     const Eigen::Isometry3d& T_wv = f.truth->T_world_vehicle;
     const Eigen::Isometry3d T_vw = T_wv.inverse();
     std::vector<objects::IdPosition> gt_ids, track_ids;
@@ -185,29 +179,29 @@ void Scorer::Add(const std::string& log_path, int log_index) {
       for (const auto& o : f.truth->objects) {
         if (o.class_name != cls) continue;
         const Eigen::Vector2d v = (T_vw * o.center_m).head<2>();
-        if (v.norm() > params.range_m) continue;
+        if (v.norm() > params_.range_m) continue;
         truth.push_back(v);
         truth_id.push_back(o.id);
         truth_box.push_back(&o);
         const double visible = calibration ? sim::VisibleFraction(o, f.truth->objects, *calibration, T_wv) : 0.0;
         truth_visible_fraction.push_back(visible);
-        truth_visible.push_back(calibration && visible >= params.min_visible_fraction);
+        truth_visible.push_back(calibration && visible >= params_.min_visible_fraction);
       }
       for (const auto& o : f.obstacles->obstacles) {
-        if (o.class_name != cls || o.center_m.head<2>().norm() > params.range_m) continue;
+        if (o.class_name != cls || o.center_m.head<2>().norm() > params_.range_m) continue;
         det.push_back(o.center_m.head<2>());
         det_track.push_back(o.track_id);
         det_box.push_back(&o);
       }
-      const auto m = Match(truth, det, cls == "car" ? params.car_match_m : params.pedestrian_match_m);
-      ClassScore& score = cls == "car" ? out.car : out.pedestrian;
+      const auto m = Match(truth, det, cls == "car" ? params_.car_match_m : params_.pedestrian_match_m);
+      ClassScore& score = cls == "car" ? out_.car : out_.pedestrian;
       score.truths += static_cast<std::int64_t>(truth.size());
       score.detections += static_cast<std::int64_t>(det.size());
       score.matched_truths += static_cast<std::int64_t>(m.size());
       score.matched_detections += static_cast<std::int64_t>(m.size());
       if (calibration) {
         // Hidden truths are "don't care": neither a miss nor, when detected anyway, a false alarm.
-        ClassScore& seen = cls == "car" ? out.car_visible : out.pedestrian_visible;
+        ClassScore& seen = cls == "car" ? out_.car_visible : out_.pedestrian_visible;
         std::int64_t matched_visible = 0, matched_hidden = 0;
         for (const auto& [i, j] : m) (truth_visible[i] ? matched_visible : matched_hidden) += 1;
         seen.truths += std::count(truth_visible.begin(), truth_visible.end(), true);
@@ -218,11 +212,11 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         for (const auto& [i, j] : m) matched[i] = used[j] = true;
         for (std::size_t j = 0; j < det.size(); ++j) {
           if (used[j]) continue;
-          out.false_alarms.push_back(DescribeFalseAlarm(log_index, frame_index, cls, *det_box[j], f.truth->objects, T_vw));
+          out_.false_alarms.push_back(DescribeFalseAlarm(log_index, frame_index, cls, *det_box[j], f.truth->objects, T_vw));
         }
         for (std::size_t i = 0; i < truth.size(); ++i) {
           if (matched[i] || !truth_visible[i]) continue;
-          out.misses.push_back(DescribeMiss(log_index, frame_index, cls, truth_id[i], truth[i],
+          out_.misses.push_back(DescribeMiss(log_index, frame_index, cls, truth_id[i], truth[i],
                                             HeadingIn(T_vw, truth_box[i]->yaw_rad), truth_visible_fraction[i],
                                             f.obstacles->obstacles));
         }
@@ -248,7 +242,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
     for (const auto& p : f.predictions) {
       // The pedestrian this prediction is about: nearest truth to the observed position.
       int best = -1;
-      double best_d = params.pedestrian_match_m;
+      double best_d = params_.pedestrian_match_m;
       for (const auto& o : f.truth->objects) {
         if (o.class_name != "pedestrian") continue;
         const double d = ((T_vw * o.center_m).head<2>() - p.observed.vehicle_xy_m).norm();
@@ -282,7 +276,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
       for (const auto& bay : f.truth->bays) {
         const Eigen::Vector2d bay_v = (T_vw * bay.center_m).head<2>();
         const pi::ParkingSlot* found = nullptr;
-        double best = params.slot_match_m;
+        double best = params_.slot_match_m;
         for (const auto& s : f.slots->slots) {
           const double d = (s.target.position_m - bay.center_m.head<2>()).norm();
           if (d < best) {
@@ -291,25 +285,25 @@ void Scorer::Add(const std::string& log_path, int log_index) {
           }
         }
         if (!bay.feasible) {
-          if (found != nullptr && found->feasible) ++out.narrow_reported_feasible;
+          if (found != nullptr && found->feasible) ++out_.narrow_reported_feasible;
           continue;
         }
-        if (bay_v.norm() > params.bay_visible_range_m) continue;
-        ++out.slot_visible_frames;
+        if (bay_v.norm() > params_.bay_visible_range_m) continue;
+        ++out_.slot_visible_frames;
         if (found != nullptr && found->feasible) {
-          ++out.slot_found_frames;
+          ++out_.slot_found_frames;
           slot_center_.push_back(best);
           slot_yaw_.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
         }
       }
     }
   }
-  if (out.frames == frames_before) {
+  if (out_.frames == frames_before) {
     Fail("eval scene: " + log_path + " has no frame with both ground truth (" +
          sim::kGroundTruthChannel + ") and outputs (" + pi::kObstaclesChannel + ")");
   }
-  ++out.logs;
-  out.id_switches += switches.score().id_switches;
+  ++out_.logs;
+  out_.id_switches += switches.score().id_switches;
 }
 
 SceneEval Scorer::Finish() {
@@ -334,20 +328,7 @@ SceneEval Scorer::Finish() {
   return out;
 }
 
-}  // namespace
 
-SceneEval EvaluateSceneLogs(const std::vector<std::string>& log_paths, const SceneEvalParams& params) {
-  if (log_paths.empty()) Fail("eval scene: no log given");
-  Scorer scorer(params);
-  for (std::size_t k = 0; k < log_paths.size(); ++k) scorer.Add(log_paths[k], static_cast<int>(k));
-  return scorer.Finish();
-}
-
-SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
-  return EvaluateSceneLogs({log_path}, params);
-}
-
-namespace {
 // "frame N", or "log K frame N" when several logs were pooled.
 std::string Where(std::int64_t logs, int log, std::int64_t frame) {
   return (logs > 1 ? "log " + std::to_string(log) + " " : std::string()) + "frame " + std::to_string(frame);
@@ -363,7 +344,20 @@ std::string ClassJson(const ClassScore& score, bool with_center) {
      << ", \"detections\":" << score.detections << ", \"matched_detections\":" << score.matched_detections << "}";
   return js.str();
 }
+
 }  // namespace
+
+SceneEval EvaluateSceneLogs(const std::vector<std::string>& log_paths, const SceneEvalParams& params) {
+  if (log_paths.empty()) Fail("eval scene: no log given");
+  Scorer scorer(params);
+  for (std::size_t k = 0; k < log_paths.size(); ++k) scorer.Add(log_paths[k], static_cast<int>(k));
+  return scorer.Finish();
+}
+
+SceneEval EvaluateSceneLog(const std::string& log_path, const SceneEvalParams& params) {
+  return EvaluateSceneLogs({log_path}, params);
+}
+
 
 std::string SceneEval::ToJson() const {
   std::ostringstream js;
