@@ -12,6 +12,7 @@
 #include "romo/core/check.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo/planning_iface/lcm_bus.hpp"
+#include "romo/sim/ground_truth.hpp"
 #include "romo/viz/top_view.hpp"
 
 namespace romo::pipeline {
@@ -36,6 +37,7 @@ class OutputSink::Impl {
   // Summary state.
   struct StageSummary {
     std::optional<FrameResult> last;
+    std::vector<viz::TruthOutline> last_truth;
     std::vector<Eigen::Vector2d> trail;
     std::int64_t first_seq = -1, last_seq = -1, frames = 0;
   };
@@ -66,6 +68,29 @@ class OutputSink::Impl {
     LogCalibrationOnce(stamp_ns);
     if (log) log->WriteRaw(channel, stamp_ns, bytes.data(), bytes.size());
     if (bus) bus->Publish(channel, bytes);
+  }
+
+  // The true footprints in a passed-through ground-truth message (a simulated run, or a recording
+  // of one), for the pictures. An unreadable one is reported once and the pictures go without:
+  // they are a view, and the frame's outputs must still be written.
+  bool truth_unreadable_reported = false;
+  std::vector<viz::TruthOutline> TruthOutlines(const std::vector<drivers::LogEvent>& passthrough) {
+    std::vector<viz::TruthOutline> outlines;
+    for (const auto& e : passthrough) {
+      if (e.channel != sim::kGroundTruthChannel) continue;
+      try {
+        const sim::GroundTruth truth = sim::DecodeGroundTruth(e.data.data(), e.data.size(), e.channel);
+        for (const auto& o : truth.objects) outlines.push_back({o.class_name, o.Footprint()});
+      } catch (const std::exception& err) {
+        if (!truth_unreadable_reported) {
+          const std::string what = std::string("pictures drawn without ground truth: ") + err.what();
+          std::fprintf(stderr, "romo: %s\n", what.c_str());
+          events.push_back(what);
+          truth_unreadable_reported = true;
+        }
+      }
+    }
+    return outlines;
   }
 
   void RecordStatus(const pi::PerceptionStatus& status) {
@@ -128,10 +153,12 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
   }
   for (const auto& [channel, bytes] : messages) s.Emit(channel, r.stamp_ns, bytes);
   if (s.csv) s.csv->WriteFrame(r.predictions);
-  if (!s.options.out_dir.empty() && s.options.frame_pictures) {
+  const bool pictures = !s.options.out_dir.empty();
+  std::vector<viz::TruthOutline> truth = pictures ? s.TruthOutlines(passthrough) : std::vector<viz::TruthOutline>{};
+  if (pictures && s.options.frame_pictures) {
     char name[64];
     std::snprintf(name, sizeof(name), "/frames/frame_%06lld.png", static_cast<long long>(r.frame_sequence));
-    viz::WritePng(s.options.out_dir + name, viz::DrawTopView(r, s.view, {}, ""));
+    viz::WritePng(s.options.out_dir + name, viz::DrawTopView(r, s.view, {}, "", truth));
   }
 
   // Summary bookkeeping.
@@ -163,6 +190,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
     ++sum.frames;
     sum.trail.push_back(r.ego_world.position_m);
     sum.last = r;
+    sum.last_truth = std::move(truth);
   }
 }
 
@@ -189,7 +217,7 @@ void OutputSink::Finish(const std::string& extra_json) {
     char title[96];
     std::snprintf(title, sizeof(title), "[%s: frames %lld-%lld]", name.c_str(),
                   static_cast<long long>(sum.first_seq), static_cast<long long>(sum.last_seq));
-    viz::WritePng(s.options.out_dir + "/" + file, viz::DrawTopView(*sum.last, s.view, sum.trail, title));
+    viz::WritePng(s.options.out_dir + "/" + file, viz::DrawTopView(*sum.last, s.view, sum.trail, title, sum.last_truth));
     stages_json << (first ? "" : ",") << "\"" << name << "\":{\"frames\":" << sum.frames
                 << ",\"first_frame\":" << sum.first_seq << ",\"last_frame\":" << sum.last_seq
                 << ",\"picture\":\"" << file << "\"}";

@@ -44,6 +44,18 @@ class Canvas {
     const Eigen::Vector2d b(-std::sin(yaw) * width / 2, std::cos(yaw) * width / 2);
     Polygon({c + a + b, c - a + b, c - a - b, c + a - b}, colour, thickness);
   }
+  // Dashes of about @p dash_px: an outline that must not be taken for a detection's box.
+  void DashedPolygon(const std::vector<Eigen::Vector2d>& pts, const cv::Scalar& colour, double dash_px) {
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const cv::Point2d a = Px(pts[k]), b = Px(pts[(k + 1) % pts.size()]);
+      const double len = std::hypot(b.x - a.x, b.y - a.y);
+      const int dashes = std::max(1, static_cast<int>(len / (2 * dash_px)));
+      for (int d = 0; d < dashes; ++d) {
+        const double t0 = (2.0 * d) / (2 * dashes), t1 = (2.0 * d + 1) / (2 * dashes);
+        cv::line(img, a + (b - a) * t0, a + (b - a) * t1, colour, 1, cv::LINE_AA);
+      }
+    }
+  }
   double scale() const { return scale_; }
   cv::Mat img;
 
@@ -60,7 +72,8 @@ void TopViewParams::Validate() const {
 }
 
 cv::Mat DrawTopView(const pipeline::FrameResult& f, const TopViewParams& params,
-                    const std::vector<Eigen::Vector2d>& ego_trail, const std::string& title) {
+                    const std::vector<Eigen::Vector2d>& ego_trail, const std::string& title,
+                    const std::vector<TruthOutline>& truth) {
   params.Validate();
   Canvas cv_(params, f.ego_world.position_m);
   const Eigen::Isometry3d& T = f.T_world_vehicle;
@@ -126,9 +139,13 @@ cv::Mat DrawTopView(const pipeline::FrameResult& f, const TopViewParams& params,
                 0.4, colour, 1, cv::LINE_AA);
   }
 
+  // Truth under the detections, lighter than their class colour.
+  for (const auto& t : truth) {
+    cv_.DashedPolygon(t.corners_world, ClassColour(t.class_name) * 0.5 + cv::Scalar(110, 110, 110), 6);
+  }
+
   // Boxes with class and track id.
   std::vector<int> track_of(f.boxes.size(), -1);
-  for (const auto& o : f.obstacles.obstacles) (void)o;
   for (std::size_t i = 0; i < f.obstacles.obstacles.size() && i < f.boxes.size(); ++i) {
     track_of[i] = f.obstacles.obstacles[i].track_id;
   }
@@ -175,7 +192,7 @@ cv::Mat DrawTopView(const pipeline::FrameResult& f, const TopViewParams& params,
                 f.boxes.size(), f.tracks.size(), f.slots.slots.size(), missing.empty() ? "" : "  MISSING rigs:",
                 missing.c_str());
   cv::putText(cv_.img, line, {8, 36}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
-  cv::putText(cv_.img, "N^  5 m grid", {8, cv_.img.rows - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
+  cv::putText(cv_.img, truth.empty() ? "N^  5 m grid" : "N^  5 m grid   dashed: ground truth", {8, cv_.img.rows - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
               cv::Scalar(150, 150, 150), 1, cv::LINE_AA);
   return cv_.img;
 }

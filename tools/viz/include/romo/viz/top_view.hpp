@@ -20,10 +20,17 @@ struct TopViewParams {
   void Validate() const;
 };
 
-/// Draws @p frame; @p ego_trail (world xy) is drawn as the ego's path when given.
+/// An object's true footprint (a simulated or annotated run), drawn under the detections.
+struct TruthOutline {
+  std::string class_name;
+  std::vector<Eigen::Vector2d> corners_world;  ///< closed polygon, world xy
+};
+
+/// Draws @p frame; @p ego_trail (world xy) is drawn as the ego's path when given, @p truth as
+/// thin dashed outlines so what was missed or misplaced shows beside what was found.
 cv::Mat DrawTopView(const pipeline::FrameResult& frame, const TopViewParams& params,
                     const std::vector<Eigen::Vector2d>& ego_trail = {},
-                    const std::string& title = "");
+                    const std::string& title = "", const std::vector<TruthOutline>& truth = {});
 
 /// Writes @p image as PNG; @throws romo::Error naming the path when it cannot.
 void WritePng(const std::string& path, const cv::Mat& image);
