@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command_registry.hpp"
+#include "cli/picture_options.hpp"
 #include "romo/core/check.hpp"
 #include "romo/drivers/recording.hpp"
 #include "romo/pipeline/outputs.hpp"
@@ -43,7 +44,7 @@ struct FuseOptions {
   int timeout_ms = 500;
   double idle_exit_s = 10.0;
   long long frames = 0;
-  bool no_pictures = false;
+  pipeline::OutputOptions pictures;  ///< --no-pictures, --picture-span (the rest comes from the fields above)
   // A full-resolution rig cloud (782 x 582 points at 8 bytes) is 3.6 MB; anything far larger is
   // refused before decoding so a bad or hostile sender cannot make fuse allocate without bound.
   std::size_t max_message_bytes = 8u << 20;
@@ -204,11 +205,10 @@ void Fuse(const FuseOptions& o) {
   // the plain defaults are half resolution's, as `romo replay` takes them for half-size recordings.
   FusePipeline pipe(calibration,
                     o.calib.empty() ? pipeline::PipelineParams{} : pipeline::PipelineParams::ForCalibration(calibration, pipeline::PipelineParams{}.threads));
-  pipeline::OutputOptions out;
+  pipeline::OutputOptions out = o.pictures;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
   out.log_inputs = false;
-  out.frame_pictures = !o.no_pictures;
   pipeline::OutputSink sink(calibration, out);
   // Recent fixes by stamp (a few seconds at any GNSS rate); the pipeline reports frames without one.
   std::map<std::int64_t, drivers::GnssFix> fixes;
@@ -392,7 +392,7 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--timeout-ms", opts->timeout_ms, "wait this long for a frame's missing rigs")->capture_default_str();
   cmd->add_option("--idle-exit", opts->idle_exit_s, "exit after this many seconds without messages (counted from the first)")->capture_default_str();
   cmd->add_option("--frames", opts->frames, "exit after this many frames (0 = until idle)");
-  cmd->add_flag("--no-pictures", opts->no_pictures, "skip the per-frame top-view PNGs (with --out)");
+  AddPictureOptions(*cmd, opts->pictures);
   cmd->add_option("--max-message-bytes", opts->max_message_bytes,
                   "refuse (count as malformed) rig clouds larger than this")
       ->capture_default_str()

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command_registry.hpp"
+#include "cli/picture_options.hpp"
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
 #include "romo/drivers/recording.hpp"
@@ -24,7 +25,7 @@ struct ReplayOptions {
   bool realtime = false;
   long long frames = 0;
   int threads = 2;
-  bool no_pictures = false;
+  pipeline::OutputOptions pictures;  ///< --no-pictures, --picture-span (the rest comes from the fields above)
   bool loop = false;
   double duration_s = 0.0;
 };
@@ -41,10 +42,9 @@ void Replay(const ReplayOptions& o) {
          " has no calibration (no ROMO_CALIBRATION event): pass one with --calib FILE");
   }
   pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, o.threads));
-  pipeline::OutputOptions out;
+  pipeline::OutputOptions out = o.pictures;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
-  out.frame_pictures = !o.no_pictures;
   pipeline::OutputSink sink(calibration, out);
   Progress progress("replay", o.frames > 0 ? static_cast<std::uint64_t>(o.frames) : 0);
   pipeline::RunOptions run;
@@ -94,7 +94,7 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_flag("--realtime", opts->realtime, "pace frames by their stamps (default: as fast as possible)");
   cmd->add_option("--frames", opts->frames, "stop after this many frames (0 = all)")->capture_default_str();
   cmd->add_option("--threads", opts->threads, "stereo threads (rigs in parallel)")->capture_default_str();
-  cmd->add_flag("--no-pictures", opts->no_pictures, "skip the per-frame top-view PNGs");
+  AddPictureOptions(*cmd, opts->pictures);
   cmd->add_flag("--loop", opts->loop, "start over at the end (stamps keep increasing); needs --duration or --frames");
   cmd->add_option("--duration", opts->duration_s, "stop after this many seconds of wall time (0 = no limit)")
       ->check(CLI::NonNegativeNumber);

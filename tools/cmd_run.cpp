@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command_registry.hpp"
+#include "cli/picture_options.hpp"
 #include "cli/progress.hpp"
 #include "romo/core/check.hpp"
 #include "romo/drivers/frame_source.hpp"
@@ -32,7 +33,7 @@ struct RunCmdOptions {
   std::string lcm_url = "memq://";
   bool realtime = false;
   int threads = 2;
-  bool no_pictures = false;
+  pipeline::OutputOptions pictures;  ///< --no-pictures, --picture-span (the rest comes from the fields above)
 };
 
 void RunDefault(const RunCmdOptions& o) {
@@ -51,10 +52,9 @@ void RunDefault(const RunCmdOptions& o) {
   auto* sim_source = dynamic_cast<sim::SimSource*>(source.get());
 
   pipeline::Pipeline pipe(calibration, pipeline::PipelineParams::ForCalibration(calibration, o.threads));
-  pipeline::OutputOptions out;
+  pipeline::OutputOptions out = o.pictures;
   out.out_dir = o.out_dir;
   out.lcm_url = o.lcm_url;
-  out.frame_pictures = !o.no_pictures;
   pipeline::OutputSink sink(calibration, out);
 
   std::fprintf(stderr, "romo run: %s -> %s (LCM %s)\n", uri.c_str(), o.out_dir.c_str(),
@@ -107,7 +107,7 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--lcm-url", opts->lcm_url, "publish outputs here (\"\" = off)")->capture_default_str();
   cmd->add_flag("--realtime", opts->realtime, "pace frames by their stamps");
   cmd->add_option("--threads", opts->threads, "threads for rendering and stereo")->capture_default_str();
-  cmd->add_flag("--no-pictures", opts->no_pictures, "skip the per-frame top-view PNGs");
+  AddPictureOptions(*cmd, opts->pictures);
   cmd->callback([opts] { RunDefault(*opts); });
 });
 

@@ -65,15 +65,16 @@ TEST(TopViewTest, TruthIsDrawnDashedWhereItIs) {
 }
 
 // A sink writing one frame with @p truth passed through, as `romo run` and `romo replay` do.
-void WriteOneFrame(const std::string& out_dir, const romo::drivers::LogEvent& truth) {
+void WriteOneFrame(const std::string& out_dir, const romo::drivers::LogEvent& truth, double span_m = 36.0) {
   romo::pipeline::OutputOptions options;
   options.out_dir = out_dir;
+  options.picture_span_m = span_m;
   romo::pipeline::OutputSink sink(romo::sim::SimCalibration(romo::sim::SimParams{}), options);
   sink.Write(nullptr, EmptyFrame(), {truth});
   sink.Finish();
 }
 
-TEST(TopViewTest, RunPicturesShowThePassedThroughTruth) {
+romo::drivers::LogEvent TruthOfOnePerson(romo::sim::GtBox* person_out) {
   romo::sim::GroundTruth truth;
   romo::sim::GtBox person;
   person.id = 7;
@@ -81,9 +82,16 @@ TEST(TopViewTest, RunPicturesShowThePassedThroughTruth) {
   person.center_m = {3.6, -6.2, 0.85};
   person.size_m = {0.6, 0.6, 1.7};
   truth.objects.push_back(person);
+  *person_out = person;
   romo::drivers::LogEvent e;
   e.channel = romo::sim::kGroundTruthChannel;
   e.data = romo::sim::Encode(truth);
+  return e;
+}
+
+TEST(TopViewTest, RunPicturesShowThePassedThroughTruth) {
+  romo::sim::GtBox person;
+  const romo::drivers::LogEvent e = TruthOfOnePerson(&person);
   romo::test::ScratchDir dir;
   WriteOneFrame(dir.path(), e);
   const cv::Mat img = cv::imread(dir / "frames/frame_000000.png");
@@ -94,6 +102,28 @@ TEST(TopViewTest, RunPicturesShowThePassedThroughTruth) {
   const cv::Mat direct =
       romo::viz::DrawTopView(EmptyFrame(), view, {}, "", {TruthOutline{"pedestrian", person.Footprint()}});
   EXPECT_EQ(cv::norm(img, direct, cv::NORM_INF), 0.0);
+}
+
+TEST(TopViewTest, PictureSpanZoomsAboutTheVehicle) {
+  romo::sim::GtBox person;
+  const romo::drivers::LogEvent e = TruthOfOnePerson(&person);
+  romo::test::ScratchDir dir;
+  WriteOneFrame(dir.path(), e, 18.0);
+  const cv::Mat img = cv::imread(dir / "frames/frame_000000.png");
+  ASSERT_FALSE(img.empty());
+  romo::viz::TopViewParams zoomed;
+  zoomed.span_m = 18.0;
+  // Twice the pixels per metre: the near side lies where the 18 m scale puts it, not the 36 m one.
+  EXPECT_GT(PaintedFraction(img, zoomed, {3.3, -6.5}, {3.3, -5.9}), 0.3);
+  EXPECT_EQ(PaintedFraction(img, romo::viz::TopViewParams{}, {3.3, -6.5}, {3.3, -5.9}), 0.0);
+}
+
+TEST(TopViewTest, PictureSpanOutOfRangeIsRefusedByName) {
+  for (const char* command : {"run", "replay x.lcmlog", "fuse"}) {
+    const auto res = romo::test::RunRomo(std::string(command) + " --picture-span 0.5");
+    EXPECT_NE(res.exit_code, 0) << command;
+    EXPECT_NE((res.err + res.out).find("--picture-span"), std::string::npos) << command << ": " << res.err;
+  }
 }
 
 TEST(TopViewTest, UnreadableTruthCostsTheOverlayNotTheFrame) {

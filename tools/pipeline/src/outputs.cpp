@@ -106,6 +106,7 @@ OutputSink::OutputSink(const drivers::Calibration& calibration, const OutputOpti
     : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
   impl_->view.size_px = options.picture_size_px;
+  impl_->view.span_m = options.picture_span_m;
   impl_->view.Validate();
   if (!options.out_dir.empty()) {
     std::error_code ec;

@@ -21,6 +21,7 @@ struct OutputOptions {
   bool log_inputs = true;      ///< inputs (images, vehicle state, GNSS) into outputs.lcmlog
   bool frame_pictures = true;  ///< frames/frame_<seq>.png
   int picture_size_px = 800;
+  double picture_span_m = 36.0;  ///< metres across a picture, centred on the vehicle
 };
 
 /// Output channels written per frame (besides the inputs and passed-through channels).
