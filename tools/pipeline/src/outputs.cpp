@@ -154,9 +154,10 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
   }
   for (const auto& [channel, bytes] : messages) s.Emit(channel, r.stamp_ns, bytes);
   if (s.csv) s.csv->WriteFrame(r.predictions);
-  const bool pictures = !s.options.out_dir.empty();
-  std::vector<viz::TruthOutline> truth = pictures ? s.TruthOutlines(passthrough) : std::vector<viz::TruthOutline>{};
-  if (pictures && s.options.frame_pictures) {
+  // The truth is drawn in this frame's picture and, if it ends its stage, in the stage picture.
+  const bool writes_files = !s.options.out_dir.empty();
+  std::vector<viz::TruthOutline> truth = writes_files ? s.TruthOutlines(passthrough) : std::vector<viz::TruthOutline>{};
+  if (writes_files && s.options.frame_pictures) {
     char name[64];
     std::snprintf(name, sizeof(name), "/frames/frame_%06lld.png", static_cast<long long>(r.frame_sequence));
     viz::WritePng(s.options.out_dir + name, viz::DrawTopView(r, s.view, {}, "", truth));

@@ -51,8 +51,8 @@ class Canvas {
       const double len = std::hypot(b.x - a.x, b.y - a.y);
       const int dashes = std::max(1, static_cast<int>(len / (2 * dash_px)));
       for (int d = 0; d < dashes; ++d) {
-        const double t0 = (2.0 * d) / (2 * dashes), t1 = (2.0 * d + 1) / (2 * dashes);
-        cv::line(img, a + (b - a) * t0, a + (b - a) * t1, colour, 1, cv::LINE_AA);
+        const double start = static_cast<double>(d) / dashes, end = (d + 0.5) / dashes;  // then a gap as long
+        cv::line(img, a + (b - a) * start, a + (b - a) * end, colour, 1, cv::LINE_AA);
       }
     }
   }
