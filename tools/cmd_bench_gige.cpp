@@ -40,6 +40,7 @@ struct Options {
   int width = 782;
   int height = 582;
   bool baseline = true;
+  bool packet_socket = false;  // both romo and the baseline receive the same way
   std::string netns_run;
 };
 
@@ -166,8 +167,9 @@ void Run(const Options& options, const std::string& self_args) {
   const int cameras = 2 * options.rigs;
   const double warmup_s = 1.5;
   std::printf("romo bench gige: %d emulated cameras (%d rigs), %dx%d (rig 0 RGB8, others Mono16), "
-              "%.1f Hz, %.1f s per run\n",
-              cameras, options.rigs, options.width, options.height, options.rate_hz, options.seconds);
+              "%.1f Hz, %.1f s per run, received through %s\n",
+              cameras, options.rigs, options.width, options.height, options.rate_hz, options.seconds,
+              options.packet_socket ? "Aravis' packet socket" : "UDP sockets");
   std::fflush(stdout);
   const pid_t emulator = StartEmulator(options);
   Progress progress("bench gige", static_cast<std::uint64_t>(
@@ -176,6 +178,7 @@ void Run(const Options& options, const std::string& self_args) {
 
   drivers::GigeConfig config;
   config.stall_timeout_s = 10.0;
+  config.packet_socket = options.packet_socket;
   for (int rig = 0; rig < options.rigs; ++rig) {
     drivers::GigeRigConfig rig_config;
     rig_config.rig_id = rig;
@@ -227,8 +230,14 @@ void Run(const Options& options, const std::string& self_args) {
         prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)) _exit(127);
         const std::string rate = std::to_string(options.rate_hz);
-        execlp("arv-camera-test-0.8", "arv-camera-test-0.8", "-n", Address(camera).c_str(), "-f",
-               rate.c_str(), static_cast<char*>(nullptr));
+        // Through a UDP socket it needs a receive buffer of a frame or more, as romo sizes its own.
+        if (options.packet_socket) {
+          execlp("arv-camera-test-0.8", "arv-camera-test-0.8", "-n", Address(camera).c_str(), "-f",
+                 rate.c_str(), static_cast<char*>(nullptr));
+        } else {
+          execlp("arv-camera-test-0.8", "arv-camera-test-0.8", "-n", Address(camera).c_str(), "-f",
+                 rate.c_str(), "--no-packet-socket", "--auto", static_cast<char*>(nullptr));
+        }
         _exit(127);
       }
       grabbers.push_back(pid);
@@ -296,13 +305,16 @@ void Register(CLI::App& root) {
   command->add_option("--width", options->width, "Image width (default 782)")->check(CLI::Range(16, 4096));
   command->add_option("--height", options->height, "Image height (default 582)")->check(CLI::Range(16, 4096));
   command->add_flag("!--no-baseline", options->baseline, "Skip the arv-camera-test-0.8 baseline run");
+  command->add_flag("--packet-socket", options->packet_socket,
+                    "Receive through Aravis' AF_PACKET ring (rig config packet_socket: true), romo "
+                    "and baseline alike; default: UDP sockets for both");
   command->add_option("--netns-run", options->netns_run,
                       "netns-run script used to re-run inside a private network namespace");
   command->callback([options] {
     std::ostringstream args;
     args << "bench gige --seconds " << options->seconds << " --rigs " << options->rigs << " --rate "
          << options->rate_hz << " --width " << options->width << " --height " << options->height
-         << (options->baseline ? "" : " --no-baseline");
+         << (options->baseline ? "" : " --no-baseline") << (options->packet_socket ? " --packet-socket" : "");
     Run(*options, args.str());
   });
 }

@@ -1,6 +1,9 @@
 // The gige:// source over Aravis 0.8: a grab thread and buffer pool per camera, pairing per rig,
 // frame sets across rigs, reconnection with back-off. Everything Aravis/GLib lives in this file.
+#include <arpa/inet.h>
 #include <arv.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <time.h>
 
 #include <algorithm>
@@ -8,6 +11,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -130,6 +134,7 @@ class GigeSource::Impl {
     bool have_stamp = false;
     std::int64_t last_stamp_ns = 0;
     std::uint64_t stamp_jumps_back = 0;
+    bool receive_buffer_reported = false;
     // Aravis statistics of earlier connections, so totals survive reconnects.
     std::uint64_t stats_completed = 0, stats_failures = 0, stats_underruns = 0;
   };
@@ -390,12 +395,20 @@ class GigeSource::Impl {
     const guint payload = arv_camera_get_payload(handle, &error);
     if (error || payload == 0) return failed("payload", std::to_string(payload));
 
+    // Aravis' packet-socket receiver (taken when running with CAP_NET_RAW) opens an AF_PACKET
+    // socket that sees every packet on the host until its filter is attached, and parses what it
+    // caught as this camera's stream: a reopen amid streaming cameras got another camera's frame.
+    // The kernel's UDP port demultiplexing never mixes cameras.
+    if (!config_.packet_socket) {
+      arv_camera_gv_set_stream_options(handle, ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
+    }
     ArvStream* stream = arv_camera_create_stream(handle, nullptr, nullptr, &error);
     if (!stream) {
       const std::string text = "cannot create the stream: " + TakeError(&error);
       g_object_unref(handle);
       return text;
     }
+    if (!config_.packet_socket) SizeReceiveBuffer(camera, stream, payload);
     for (int i = 0; i < config_.buffers_per_camera; ++i) {
       arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
     }
@@ -415,6 +428,51 @@ class GigeSource::Impl {
     camera->camera = handle;
     camera->stream = stream;
     return "";
+  }
+
+  // A frame arrives as one burst of packets; the UDP socket must hold a few whole frames or the
+  // kernel drops the tail of each (the usual default receive buffer is smaller than one frame).
+  // Sized here, before the first frame: Aravis would only size it once packets arrive. Without
+  // CAP_NET_ADMIN the kernel caps it at net.core.rmem_max, which is then said once per camera.
+  void SizeReceiveBuffer(Camera* camera, ArvStream* stream, guint payload) {
+    const int wanted = static_cast<int>(std::min<std::uint64_t>(4ull * payload, 64ull << 20));
+    int size = 0;
+    const int fd = StreamSocket(arv_gv_stream_get_port(ARV_GV_STREAM(stream)));
+    if (fd >= 0) {
+      if (setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &wanted, sizeof wanted) != 0) {
+        setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &wanted, sizeof wanted);
+      }
+      socklen_t length = sizeof size;
+      getsockopt(fd, SOL_SOCKET, SO_RCVBUF, &size, &length);
+      size /= 2;  // Linux reports twice the size asked for (its bookkeeping overhead)
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (size >= 2 * static_cast<int>(payload) || camera->receive_buffer_reported) return;
+    camera->receive_buffer_reported = true;
+    AddEvent("gige: " + camera->label + ": " +
+             (fd < 0 ? std::string("stream socket not found, receive buffer left as it is")
+                     : "receive buffer " + std::to_string(size) + " bytes") +
+             ", under two frames (" + std::to_string(2ull * payload) +
+             "): frames may arrive incomplete; raise net.core.rmem_max to " + std::to_string(wanted) +
+             " or set packet_socket: true");
+  }
+
+  // Aravis keeps its stream socket to itself: it is this process's UDP socket bound to @p port.
+  static int StreamSocket(guint16 port) {
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", error)) {
+      const int fd = std::atoi(entry.path().filename().c_str());
+      sockaddr_in address{};
+      socklen_t length = sizeof address;
+      int type = 0;
+      socklen_t type_length = sizeof type;
+      if (getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0 &&
+          address.sin_family == AF_INET && ntohs(address.sin_port) == port &&
+          getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &type_length) == 0 && type == SOCK_DGRAM) {
+        return fd;
+      }
+    }
+    return -1;
   }
 
   void CloseCamera(Camera* camera, bool stop) {
@@ -457,7 +515,8 @@ class GigeSource::Impl {
          (seen.empty() ? "none" : seen));
   }
 
-  void Deliver(Camera* camera, ArvBuffer* buffer) {
+  // Returns whether the buffer carries a block id, i.e. the camera sent at least one packet of it.
+  bool Deliver(Camera* camera, ArvBuffer* buffer) {
     const ArvBufferStatus buffer_status = arv_buffer_get_status(buffer);
     const std::uint64_t frame_id = arv_buffer_get_frame_id(buffer);
     std::optional<CameraFrame> frame;
@@ -525,7 +584,7 @@ class GigeSource::Impl {
       if (!convert_error.empty() && counters.incomplete == 1) {
         AddEvent("gige: " + camera->label + ": bad buffer: " + convert_error);
       }
-      return;
+      return have_id;
     }
     ++counters.completed;
     Rig& rig = *camera->rig;
@@ -548,6 +607,7 @@ class GigeSource::Impl {
       }
     }
     if (added) ready_cv_.notify_all();
+    return true;
   }
 
   void Run(Camera* camera) {
@@ -609,9 +669,14 @@ class GigeSource::Impl {
       }
       ArvBuffer* buffer = arv_stream_timeout_pop_buffer(camera->stream, 20000);
       const auto now = Clock::now();
+      // Aravis may hand back a buffer no packet reached (seen after reopening a stalled camera):
+      // that is no sign of the camera, so it neither ends an outage nor postpones one.
+      bool camera_sent = false;
       if (buffer) {
-        Deliver(camera, buffer);
+        camera_sent = Deliver(camera, buffer);
         arv_stream_push_buffer(camera->stream, buffer);
+      }
+      if (camera_sent) {
         if (waiting_first_frame && camera->counters.reconnects > 0) {
           const auto gap = now - lost_since;
           std::lock_guard<std::mutex> lock(mutex_);

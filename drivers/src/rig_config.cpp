@@ -178,7 +178,7 @@ GigeConfig GigeConfig::FromYaml(const std::string& yaml_text, const std::string&
   if (!root.IsMap()) Fail(origin + ": expected a YAML map with a 'rigs' list, got '" + NodeText(root) + "'");
   RejectUnknownKeys(root,
                     {"rigs", "discovery_timeout_s", "lost_timeout_s", "max_backoff_s",
-                     "stall_timeout_s", "buffers_per_camera"},
+                     "stall_timeout_s", "buffers_per_camera", "packet_socket"},
                     origin, "");
   GigeConfig config;
   Optional(root, "discovery_timeout_s", origin, "", "seconds", &config.discovery_timeout_s);
@@ -186,6 +186,7 @@ GigeConfig GigeConfig::FromYaml(const std::string& yaml_text, const std::string&
   Optional(root, "max_backoff_s", origin, "", "seconds", &config.max_backoff_s);
   Optional(root, "stall_timeout_s", origin, "", "seconds", &config.stall_timeout_s);
   Optional(root, "buffers_per_camera", origin, "", "an integer", &config.buffers_per_camera);
+  Optional(root, "packet_socket", origin, "", "true or false", &config.packet_socket);
 
   const YAML::Node rigs = root["rigs"];
   if (!rigs) FieldError(origin, "rigs", "<missing>", "required: a list of rigs");
@@ -297,6 +298,7 @@ std::string GigeConfig::ToYaml() const {
   out << YAML::Key << "max_backoff_s" << YAML::Value << max_backoff_s;
   out << YAML::Key << "stall_timeout_s" << YAML::Value << stall_timeout_s;
   out << YAML::Key << "buffers_per_camera" << YAML::Value << buffers_per_camera;
+  out << YAML::Key << "packet_socket" << YAML::Value << packet_socket;
   out << YAML::Key << "rigs" << YAML::Value << YAML::BeginSeq;
   auto camera = [&](const char* key, const GigeCameraRef& ref) {
     out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;

@@ -11,6 +11,7 @@ namespace {
 
 constexpr const char* kGoodYaml = R"(
 discovery_timeout_s: 3
+packet_socket: true
 rigs:
   - rig_id: 0
     name: front
@@ -54,6 +55,7 @@ TEST(RigConfigTest, ReadsEveryFieldAndResolvesCalibrationBesideTheFile) {
   const GigeConfig config = GigeConfig::FromYaml(kGoodYaml, "rigs.yaml", "/etc/romo");
   ASSERT_EQ(config.rigs.size(), 2u);
   EXPECT_DOUBLE_EQ(config.discovery_timeout_s, 3.0);
+  EXPECT_TRUE(config.packet_socket);
   const GigeRigConfig& front = config.rigs[0];
   EXPECT_EQ(front.rig_id, 0);
   EXPECT_EQ(front.name, "front");
@@ -83,6 +85,7 @@ TEST(RigConfigTest, YamlRoundTripKeepsEveryValue) {
 TEST(RigConfigTest, ShippedExamplesLoad) {
   const GigeConfig one = GigeConfig::Load(test::SourcePath("config/rigs/single_rig.yaml"));
   EXPECT_EQ(one.rigs.size(), 1u);
+  EXPECT_FALSE(one.packet_socket) << "UDP sockets unless asked: they never mix cameras";
   const GigeConfig romo = GigeConfig::Load(test::SourcePath("config/rigs/romo_6rigs.yaml"));
   ASSERT_EQ(romo.rigs.size(), 6u);
   EXPECT_EQ(DeliveredFormat(romo.rigs[0].pixel_format), PixelFormat::kRgb8);  // colour front rig
@@ -136,6 +139,7 @@ TEST(RigConfigTest, EachBadValueNamesFieldAndValue) {
   // A complex key (found by fuzz_rig_yaml: it escaped as yaml-cpp's BadConversion).
   ExpectError(Replace(good, "exposure_us: 8000", "? [a, b]\n    : 8000"), {"rigs[0].(key)", "plain text"});
   ExpectError(Replace(good, "discovery_timeout_s: 3", "discovery_timeout_s: 0"), {"discovery_timeout_s", "0"});
+  ExpectError(Replace(good, "packet_socket: true", "packet_socket: maybe"), {"packet_socket", "maybe", "true or false"});
 }
 
 TEST(RigConfigTest, UnknownGigeQueryKeyIsAnError) {

@@ -66,6 +66,9 @@ struct GigeConfig {
   double max_backoff_s = 2.0;        ///< reopen attempts back off 0.1 s, 0.2 s, ... up to this
   double stall_timeout_s = 30.0;     ///< Next() ends the stream after this long without frames
   int buffers_per_camera = 8;        ///< Aravis buffer pool per camera
+  /// Receive through Aravis' AF_PACKET ring (needs CAP_NET_RAW): about a third of the CPU, but
+  /// until its filter is on, a reopened camera's ring catches other cameras' packets as its own.
+  bool packet_socket = false;
 
   /// Reads and validates @p path.
   /// @throws romo::Error naming the file, the field (e.g. "rigs[1].right.address") and the value.
