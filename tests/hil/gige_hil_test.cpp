@@ -4,6 +4,7 @@
 #include <chrono>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -32,6 +33,27 @@ GigeRigConfig Rig(double rate_hz) {
   // Separate emulator processes wake on the same period grid; stamps differ by scheduling only.
   rig.pairing_tolerance_ms = 20.0;
   return rig;
+}
+
+// What a source grabbed over @p seconds: stereo pairs and each camera's diagnostics at the end.
+struct Grabbed {
+  std::uint64_t pairs = 0;
+  std::vector<GigeCameraDiagnostics> diagnostics;
+};
+Grabbed Grab(const GigeConfig& config, const std::string& origin, double seconds) {
+  Grabbed grabbed;
+  GigeSource source(config, origin);
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < end) {
+    auto set = source.Next();
+    if (!set) {
+      ADD_FAILURE() << origin << ": the stream ended";
+      break;
+    }
+    grabbed.pairs += set->stereo.size();
+  }
+  grabbed.diagnostics = source.diagnostics();
+  return grabbed;
 }
 
 const CameraCounters& Find(const SourceStatus& status, const std::string& id) {
@@ -176,19 +198,7 @@ TEST(GigeHilTest, PacketLossShowsAsCountedIncompleteFrames) {
   rig.right.address = "127.0.0.5";
   rig.packet_size_bytes = 1500;
   config.rigs = {rig};
-  std::uint64_t pairs = 0;
-  std::vector<GigeCameraDiagnostics> diagnostics;
-  {
-    GigeSource source(config, "lossy.yaml");
-    constexpr double kRunS = 3.0;
-    const auto end = Clock::now() + std::chrono::duration<double>(kRunS);
-    while (Clock::now() < end) {
-      auto set = source.Next();
-      ASSERT_TRUE(set);
-      pairs += set->stereo.size();
-    }
-    diagnostics = source.diagnostics();
-  }
+  const auto [pairs, diagnostics] = Grab(config, "lossy.yaml", 3.0);
   ASSERT_EQ(diagnostics.size(), 2u);
   std::uint64_t unpaired = 0, completed = 0;
   for (const auto& d : diagnostics) {
@@ -239,19 +249,7 @@ TEST_P(ReceivePathTest, EveryFrameArrivesWhole) {
   rig.left.address = "127.0.0.6";
   rig.right.address = "127.0.0.7";
   config.rigs = {rig};
-  std::uint64_t pairs = 0;
-  std::vector<GigeCameraDiagnostics> diagnostics;
-  {
-    GigeSource source(config, packet_socket ? "packet-socket.yaml" : "udp.yaml");
-    constexpr double kRunS = 2.0;
-    const auto end = Clock::now() + std::chrono::duration<double>(kRunS);
-    while (Clock::now() < end) {
-      auto set = source.Next();
-      ASSERT_TRUE(set);
-      pairs += set->stereo.size();
-    }
-    diagnostics = source.diagnostics();
-  }
+  const auto [pairs, diagnostics] = Grab(config, packet_socket ? "packet-socket.yaml" : "udp.yaml", 2.0);
   // 2 s at 20 Hz is 40 pairs; half of that leaves room for opening on a loaded machine.
   EXPECT_GE(pairs, 20u);
   for (const auto& d : diagnostics) {
