@@ -229,15 +229,12 @@ void Run(const Options& options, const std::string& self_args) {
       if (pid == 0) {
         prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)) _exit(127);
-        const std::string rate = std::to_string(options.rate_hz);
+        const std::string rate = std::to_string(options.rate_hz), address = Address(camera);
+        std::vector<const char*> argv = {"arv-camera-test-0.8", "-n", address.c_str(), "-f", rate.c_str()};
         // Through a UDP socket it needs a receive buffer of a frame or more, as romo sizes its own.
-        if (options.packet_socket) {
-          execlp("arv-camera-test-0.8", "arv-camera-test-0.8", "-n", Address(camera).c_str(), "-f",
-                 rate.c_str(), static_cast<char*>(nullptr));
-        } else {
-          execlp("arv-camera-test-0.8", "arv-camera-test-0.8", "-n", Address(camera).c_str(), "-f",
-                 rate.c_str(), "--no-packet-socket", "--auto", static_cast<char*>(nullptr));
-        }
+        if (!options.packet_socket) argv.insert(argv.end(), {"--no-packet-socket", "--auto"});
+        argv.push_back(nullptr);
+        execvp(argv[0], const_cast<char* const*>(argv.data()));
         _exit(127);
       }
       grabbers.push_back(pid);
