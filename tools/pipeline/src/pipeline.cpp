@@ -101,6 +101,13 @@ int PointsInsideFootprint(const PointCloud& cloud, const std::vector<int>& indic
   return inside;
 }
 
+// How near the vehicle (its frame's origin, on the ground) the nearest point of @p blob comes.
+double NearestRange(const PointCloud& cloud, const std::vector<int>& blob) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int i : blob) nearest = std::min(nearest, static_cast<double>(cloud.xyz.col(i).head<2>().norm()));
+  return nearest;
+}
+
 // @p blob in two along @p axis: 1-D 2-means started from its ends.
 std::array<std::vector<int>, 2> SplitAlong(const PointCloud& cloud, const std::vector<int>& blob,
                                            const Eigen::Vector3f& axis) {
@@ -207,6 +214,8 @@ PipelineParams PipelineParams::ForImageWidth(int image_width_px, int threads) {
   // Half the depth noise makes the corner of a car seen obliquely an L, not a smear: its sides
   // give the heading (see edge_heading_min_length_m).
   if (full_resolution) p.edge_heading_min_length_m = kFullResolutionEdgeHeadingM;
+  // ... and far parked cars remembered from such views are good enough to be preferred.
+  if (full_resolution) p.parked_prefer_max_range_m = std::numeric_limits<double>::infinity();
   return p;
 }
 
@@ -231,6 +240,10 @@ void PipelineParams::Validate() const {
          " >= 0, speed " + std::to_string(parked_max_speed_mps) + " m/s >= 0, margin " +
          std::to_string(parked_footprint_margin_m) + " m >= 0, range " + std::to_string(parked_max_range_m) +
          " m > 0, standing points ratio " + std::to_string(parked_standing_points_ratio) + " finite >= 0)");
+  }
+  if (!(parked_prefer_offset_m >= 0) || !(parked_prefer_max_range_m >= 0)) {
+    Fail("pipeline: parked_prefer_* out of range (offset " + std::to_string(parked_prefer_offset_m) +
+         " m >= 0, max range " + std::to_string(parked_prefer_max_range_m) + " m >= 0)");
   }
   if (!(tandem_min_length_m >= 0)) {
     Fail("pipeline: tandem_min_length_m must be >= 0, got " + std::to_string(tandem_min_length_m));
@@ -384,6 +397,7 @@ class Pipeline::Impl {
     for (std::size_t i = 0; i < detections->size(); ++i) {
       objects::Detection& d = (*detections)[i];
       if (d.classification.class_index != car_class ||
+          NearestRange(r.cloud, r.blobs[i]) > params.parked_prefer_max_range_m ||
           std::any_of(parked.begin(), parked.end(), [&](const auto& entry) {
             return (entry.second.xy_m - d.xy_m).norm() <= params.parked_prefer_offset_m;
           })) {

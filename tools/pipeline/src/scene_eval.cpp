@@ -77,6 +77,9 @@ SceneMiss DescribeMiss(int log, std::int64_t frame, const std::string& cls, int 
     miss.nearest_height_m = o.size_m.z();
     miss.nearest_points = o.num_points;
     miss.nearest_yaw_err_deg = AxisAngleDeg(yaw_rad, o.yaw_rad);
+    const Eigen::Vector2d offset = o.center_m.head<2>() - at;
+    miss.nearest_along_m = offset.dot(Eigen::Vector2d(std::cos(yaw_rad), std::sin(yaw_rad)));
+    miss.nearest_across_m = offset.dot(Eigen::Vector2d(-std::sin(yaw_rad), std::cos(yaw_rad)));
   }
   return miss;
 }
@@ -308,6 +311,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
 
 SceneEval Scorer::Finish() {
   SceneEval out = out_;
+  out.range_m = params_.range_m;
   // Visibility needs every log's calibration: scores over some of the logs would read as all.
   out.visibility_scored = out.logs > 0 && calibrated_logs_ == out.logs;
   if (!out.visibility_scored) {
@@ -382,9 +386,9 @@ std::string SceneEval::ToText() const {
   std::ostringstream t;
   t.precision(3);
   t << "frames scored: " << frames << (logs > 1 ? " in " + std::to_string(logs) + " logs" : std::string()) << "\n"
-    << "cars (<= 15 m):        precision " << car.precision() << "  recall " << car.recall() << "  ("
+    << "cars (<= " << range_m << " m):        precision " << car.precision() << "  recall " << car.recall() << "  ("
     << car.matched_truths << "/" << car.truths << " found, " << car.detections << " detections)\n"
-    << "pedestrians (<= 15 m): precision " << pedestrian.precision() << "  recall " << pedestrian.recall()
+    << "pedestrians (<= " << range_m << " m): precision " << pedestrian.precision() << "  recall " << pedestrian.recall()
     << "  (" << pedestrian.matched_truths << "/" << pedestrian.truths << " found, " << pedestrian.detections
     << " detections)\n"
     << (visibility_scored ? "" : "(no calibration in the log, or in one of the logs: objects hidden from the cameras count as misses)\n");
@@ -414,7 +418,8 @@ std::string SceneEval::MissesText() const {
     if (m.nearest_class.empty()) {
       t << "nothing within 3 m\n";
     } else {
-      t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away, " << m.nearest_length_m << " x "
+      t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away (" << m.nearest_along_m << " along, "
+        << m.nearest_across_m << " across its length), " << m.nearest_length_m << " x "
         << m.nearest_width_m << " x " << m.nearest_height_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, "
         << m.nearest_points << " points\n";
     }

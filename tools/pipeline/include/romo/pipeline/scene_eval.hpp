@@ -39,6 +39,7 @@ struct SceneMiss {
   double nearest_m = 0.0;
   double nearest_length_m = 0.0, nearest_width_m = 0.0, nearest_height_m = 0.0;
   double nearest_yaw_err_deg = 0.0;  ///< between the box axes, 0..90
+  double nearest_along_m = 0.0, nearest_across_m = 0.0;  ///< its centre's offset along / across the truth's length
   int nearest_points = 0;
 };
 
@@ -60,6 +61,7 @@ struct SceneFalseAlarm {
 struct SceneEval {
   std::int64_t frames = 0;
   std::int64_t logs = 0;  ///< runs pooled (counts summed, medians over all matches)
+  double range_m = 15.0;  ///< SceneEvalParams::range_m scored within
   ClassScore car, pedestrian;  ///< every truth within range
   /// Only truths the cameras can see (needs the calibration in the log: visibility_scored).
   ClassScore car_visible, pedestrian_visible;
