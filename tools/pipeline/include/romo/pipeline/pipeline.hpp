@@ -152,7 +152,7 @@ struct PipelineParams {
   /// memory was formed from as far away and is no better than the view now; and one formed wrong
   /// (10-15 m away stereo bridges the ends of two neighbours, boxed between them) took every later
   /// view of either car for itself, and kept both missed while the vehicle drove up the row.
-  /// Simulated scene, seeds 1-5: car precision 0.890 -> 0.896, recall 0.635 -> 0.660, pedestrian
+  /// Simulated scene, seeds 1-5 pooled: car precision 0.890 -> 0.896, recall 0.635 -> 0.660, pedestrian
   /// precision 0.762 -> 0.786, recall 0.719 -> 0.726 (seeds 6-10: cars 0.877 / 0.649 -> 0.877 /
   /// 0.672, pedestrians 0.774 / 0.721 -> 0.762 / 0.726); 4-5.5 m score alike, 6 m loses recall.
   /// At full resolution ForCalibration turns the limit off: seeds 1-5 at 782x582 without / with
