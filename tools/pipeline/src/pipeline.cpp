@@ -211,11 +211,13 @@ PipelineParams PipelineParams::ForImageWidth(int image_width_px, int threads) {
   p.threads = threads;
   const bool full_resolution = image_width_px >= 600;
   p.disparity_size = full_resolution ? 128 : 64;
-  // Half the depth noise makes the corner of a car seen obliquely an L, not a smear: its sides
-  // give the heading (see edge_heading_min_length_m).
-  if (full_resolution) p.edge_heading_min_length_m = kFullResolutionEdgeHeadingM;
-  // ... and far parked cars remembered from such views are good enough to be preferred.
-  if (full_resolution) p.parked_prefer_max_range_m = std::numeric_limits<double>::infinity();
+  if (full_resolution) {
+    // Half the depth noise makes the corner of a car seen obliquely an L, not a smear: its sides
+    // give the heading (see edge_heading_min_length_m), and far parked cars remembered from such
+    // views are good enough to be preferred (parked_prefer_max_range_m).
+    p.edge_heading_min_length_m = kFullResolutionEdgeHeadingM;
+    p.parked_prefer_max_range_m = std::numeric_limits<double>::infinity();
+  }
   return p;
 }
 
@@ -396,11 +398,12 @@ class Pipeline::Impl {
     const double m = params.parked_footprint_margin_m;
     for (std::size_t i = 0; i < detections->size(); ++i) {
       objects::Detection& d = (*detections)[i];
+      // (the blob's nearest point last: the one test that walks its points)
       if (d.classification.class_index != car_class ||
-          NearestRange(r.cloud, r.blobs[i]) > params.parked_prefer_max_range_m ||
           std::any_of(parked.begin(), parked.end(), [&](const auto& entry) {
             return (entry.second.xy_m - d.xy_m).norm() <= params.parked_prefer_offset_m;
-          })) {
+          }) ||
+          NearestRange(r.cloud, r.blobs[i]) > params.parked_prefer_max_range_m) {
         continue;
       }
       for (const auto& [id, car] : parked) {
