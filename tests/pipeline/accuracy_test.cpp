@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "romo/pipeline/scene_eval.hpp"
@@ -28,8 +29,11 @@ namespace {
 
 constexpr int kSeeds = 5;
 
+double HiddenRecall(const HiddenScore& h) { return h.truths ? double(h.matched_truths) / h.truths : 1.0; }
+
 struct Means {
   double car_p = 0, car_r = 0, ped_p = 0, ped_r = 0, car_visible_r = 0, ped_visible_r = 0;
+  double car_hidden_r = 0, ped_hidden_r = 0;  // found among the sightings hidden now
   double centre_m = 0, car_yaw_deg = 0, slot_centre_m = 0;
   long long slot_found = 0, slot_visible = 0;
 
@@ -40,6 +44,8 @@ struct Means {
     ped_r += e.pedestrian.recall() / kSeeds;
     car_visible_r += e.car_visible.recall() / kSeeds;
     ped_visible_r += e.pedestrian_visible.recall() / kSeeds;
+    car_hidden_r += HiddenRecall(e.car_hidden) / kSeeds;
+    ped_hidden_r += HiddenRecall(e.pedestrian_hidden) / kSeeds;
     centre_m += e.box_center_err_m_median / kSeeds;
     car_yaw_deg += e.car_yaw_err_deg_median / kSeeds;
     slot_centre_m += e.slot_center_err_m / kSeeds;
@@ -65,6 +71,11 @@ void PrintSceneFigures(const std::string& what, const SceneEval& e) {
               e.pedestrian_visible.precision(), e.pedestrian_visible.recall(),
               static_cast<long long>(e.pedestrian_visible.matched_truths),
               static_cast<long long>(e.pedestrian_visible.truths));
+  std::printf("FIGURE accuracy %s, objects hidden from the cameras now: car %lld/%lld found (%lld seen earlier), "
+              "pedestrian %lld/%lld (%lld seen earlier)\n",
+              what.c_str(), static_cast<long long>(e.car_hidden.matched_truths), static_cast<long long>(e.car_hidden.truths),
+              static_cast<long long>(e.car_hidden.seen_before), static_cast<long long>(e.pedestrian_hidden.matched_truths),
+              static_cast<long long>(e.pedestrian_hidden.truths), static_cast<long long>(e.pedestrian_hidden.seen_before));
   std::printf("FIGURE accuracy %s: box centre median cars %.3f m, pedestrians %.3f m\n", what.c_str(),
               e.car.center_err_m_median, e.pedestrian.center_err_m_median);
 }
@@ -99,12 +110,26 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     }
     EXPECT_EQ(static_cast<std::int64_t>(e.misses.size()), missed);
     EXPECT_EQ(static_cast<std::int64_t>(e.false_alarms.size()), false_alarms);
+    // Every sighting is either visible or hidden now, and found or not in both tallies alike.
+    for (const auto& [all, visible, hidden] : {std::tie(e.car, e.car_visible, e.car_hidden),
+                                               std::tie(e.pedestrian, e.pedestrian_visible, e.pedestrian_hidden)}) {
+      EXPECT_EQ(hidden.truths, all.truths - visible.truths);
+      EXPECT_EQ(hidden.matched_truths, all.matched_truths - visible.matched_truths);
+      EXPECT_LE(hidden.seen_before_matched, std::min(hidden.seen_before, hidden.matched_truths));
+    }
+    // In the maneuver almost every object hidden now was seen in an earlier frame (seeds 1-5: all
+    // 219 car sightings and 119 of 120 pedestrian ones): what is found of them is the memory's
+    // (remembered parked cars, coasting tracks) doing, not out of reach.
+    EXPECT_GE(e.car_hidden.seen_before, 0.9 * static_cast<double>(e.car_hidden.truths));
+    EXPECT_GE(e.pedestrian_hidden.seen_before, 0.9 * static_cast<double>(e.pedestrian_hidden.truths));
     mean.Add(e);
   }
   std::printf("FIGURE accuracy, mean of seeds 1-%d: car P %.3f R %.3f (visible R %.3f), pedestrian P %.3f R %.3f "
               "(visible R %.3f), box centre %.3f m, car yaw %.1f deg, slot %lld/%lld centre %.3f m\n",
               kSeeds, mean.car_p, mean.car_r, mean.car_visible_r, mean.ped_p, mean.ped_r, mean.ped_visible_r,
               mean.centre_m, mean.car_yaw_deg, mean.slot_found, mean.slot_visible, mean.slot_centre_m);
+  std::printf("FIGURE accuracy, mean of seeds 1-%d, objects hidden from the cameras now: car R %.3f, pedestrian R %.3f\n",
+              kSeeds, mean.car_hidden_r, mean.ped_hidden_r);
   // Floors: five-seed means measured with stacked pieces merged into people, coasting tracks
   // kept to their class's size and face pairs split at gaps of half density (car P 0.853 R 0.577,
   // visible R 0.642; pedestrian P 0.711 R 0.715, visible R 0.767; centre 0.221 m; car yaw 8.5
@@ -134,6 +159,11 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   EXPECT_LE(mean.car_yaw_deg, 8.8);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
+  // Session 19: of the sightings hidden now the memory finds cars 0.30 and pedestrians 0.38 (mean
+  // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
+  // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
+  EXPECT_GE(mean.car_hidden_r, 0.25);
+  EXPECT_GE(mean.ped_hidden_r, 0.30);
 }
 
 // The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo

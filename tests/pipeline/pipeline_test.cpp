@@ -8,6 +8,7 @@
 #include <random>
 #include <regex>
 #include <sstream>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -802,6 +803,16 @@ TEST(PipelineTest, EvalScenePoolsSeveralRuns) {
     EXPECT_EQ(sum->matched_truths, first->matched_truths + second->matched_truths);
     EXPECT_EQ(sum->detections, first->detections + second->detections);
   }
+  // The runs share truth ids (the same parking rows): an object seen in one run is not "seen
+  // before" in the next.
+  for (const auto& [sum, first, second] : {std::tie(pooled.car_hidden, one.car_hidden, two.car_hidden),
+                                           std::tie(pooled.pedestrian_hidden, one.pedestrian_hidden, two.pedestrian_hidden)}) {
+    EXPECT_EQ(sum.truths, first.truths + second.truths);
+    EXPECT_EQ(sum.matched_truths, first.matched_truths + second.matched_truths);
+    EXPECT_EQ(sum.seen_before, first.seen_before + second.seen_before);
+    EXPECT_EQ(sum.seen_before_matched, first.seen_before_matched + second.seen_before_matched);
+  }
+  EXPECT_EQ(pooled.car_hidden.truths, pooled.car.truths - pooled.car_visible.truths);
   EXPECT_EQ(pooled.slot_visible_frames, one.slot_visible_frames + two.slot_visible_frames);
   ASSERT_TRUE(pooled.visibility_scored);
   EXPECT_EQ(pooled.misses.size(), one.misses.size() + two.misses.size());
@@ -811,6 +822,8 @@ TEST(PipelineTest, EvalScenePoolsSeveralRuns) {
   const auto cli = romo::test::RunRomo("eval scene --json --log " + logs[0] + " --log " + logs[1]);
   ASSERT_EQ(cli.exit_code, 0) << cli.err;
   EXPECT_NE(cli.out.find("\"logs\":2"), std::string::npos) << cli.out;
+  EXPECT_NE(cli.out.find("\"car_hidden\":{\"truths\":" + std::to_string(pooled.car_hidden.truths) + ","), std::string::npos)
+      << cli.out;
   EXPECT_NE(cli.out.find("\"truths\":" + std::to_string(pooled.car.truths) + ","), std::string::npos) << cli.out;
   const auto listed = romo::test::RunRomo("eval scene --misses --log " + logs[0] + " " + logs[1]);
   ASSERT_EQ(listed.exit_code, 0) << listed.err;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "romo/core/angles.hpp"
@@ -157,6 +158,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
   const std::int64_t frames_before = out_.frames;
   calibrated_logs_ += calibration.has_value();
   objects::IdSwitchCounter switches(params_.car_match_m);  // track ids are per run
+  std::set<std::pair<std::string, int>> seen_so_far;  // (class, truth id) visible in an earlier frame
   // Truth positions of pedestrians over time for prediction scoring (world frame).
   std::map<int, std::map<std::int64_t, Eigen::Vector2d>> ped_truth;
   for (const auto& [stamp, f] : frames) {
@@ -213,6 +215,18 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         seen.matched_detections += matched_visible;
         std::vector<bool> matched(truth.size()), used(det.size());
         for (const auto& [i, j] : m) matched[i] = used[j] = true;
+        HiddenScore& hidden = cls == "car" ? out_.car_hidden : out_.pedestrian_hidden;
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+          if (truth_visible[i]) continue;
+          const bool seen_before = seen_so_far.count({cls, truth_id[i]}) > 0;
+          hidden.truths += 1;
+          hidden.matched_truths += matched[i];
+          hidden.seen_before += seen_before;
+          hidden.seen_before_matched += seen_before && matched[i];
+        }
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+          if (truth_visible[i]) seen_so_far.insert({cls, truth_id[i]});
+        }
         for (std::size_t j = 0; j < det.size(); ++j) {
           if (used[j]) continue;
           out_.false_alarms.push_back(DescribeFalseAlarm(log_index, frame_index, cls, *det_box[j], f.truth->objects, T_vw));
@@ -349,6 +363,20 @@ std::string ClassJson(const ClassScore& score, bool with_center) {
   return js.str();
 }
 
+std::string HiddenJson(const HiddenScore& h) {
+  std::ostringstream js;
+  js << "{\"truths\":" << h.truths << ", \"matched_truths\":" << h.matched_truths << ", \"seen_before\":" << h.seen_before
+     << ", \"seen_before_matched\":" << h.seen_before_matched << "}";
+  return js.str();
+}
+
+std::string HiddenText(const HiddenScore& h) {
+  std::ostringstream t;
+  t << h.matched_truths << "/" << h.truths << " found (" << h.seen_before << " seen in an earlier frame, "
+    << h.seen_before_matched << " of them found)";
+  return t.str();
+}
+
 }  // namespace
 
 SceneEval EvaluateSceneLogs(const std::vector<std::string>& log_paths, const SceneEvalParams& params) {
@@ -376,7 +404,8 @@ std::string SceneEval::ToJson() const {
      << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}";
   if (visibility_scored) {
     js << ", \"car_visible\":" << ClassJson(car_visible, false)
-       << ", \"pedestrian_visible\":" << ClassJson(pedestrian_visible, false);
+       << ", \"pedestrian_visible\":" << ClassJson(pedestrian_visible, false)
+       << ", \"car_hidden\":" << HiddenJson(car_hidden) << ", \"pedestrian_hidden\":" << HiddenJson(pedestrian_hidden);
   }
   js << "}";
   return js.str();
@@ -397,6 +426,8 @@ std::string SceneEval::ToText() const {
       << "  (" << car_visible.matched_truths << "/" << car_visible.truths << ");  pedestrians precision "
       << pedestrian_visible.precision() << "  recall " << pedestrian_visible.recall() << "  ("
       << pedestrian_visible.matched_truths << "/" << pedestrian_visible.truths << ")\n";
+    t << "hidden from the cameras now: cars " << HiddenText(car_hidden) << ";  pedestrians "
+      << HiddenText(pedestrian_hidden) << "\n";
   }
   t << "box errors (median): centre " << box_center_err_m_median << " m (cars " << car.center_err_m_median
     << ", pedestrians " << pedestrian.center_err_m_median << "), size " << box_size_err_m_median

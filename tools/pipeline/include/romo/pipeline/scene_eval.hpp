@@ -27,6 +27,13 @@ struct ClassScore {
   double recall() const { return truths ? double(matched_truths) / truths : 1.0; }
 };
 
+/// Truths hidden from the cameras now (below SceneEvalParams::min_visible_fraction): only memory
+/// (remembered parked cars, coasting tracks) can report them. seen_before counts those the cameras
+/// saw in an earlier frame of the same run (what memory could carry), and how many of them were found.
+struct HiddenScore {
+  std::int64_t truths = 0, matched_truths = 0, seen_before = 0, seen_before_matched = 0;
+};
+
 /// A visible truth no detection of its class matched: what was reported nearest to it instead.
 struct SceneMiss {
   int log = 0;             ///< index among the logs scored together
@@ -65,6 +72,7 @@ struct SceneEval {
   ClassScore car, pedestrian;  ///< every truth within range
   /// Only truths the cameras can see (needs the calibration in the log: visibility_scored).
   ClassScore car_visible, pedestrian_visible;
+  HiddenScore car_hidden, pedestrian_hidden;  ///< (only when visibility_scored)
   bool visibility_scored = false;
   double box_center_err_m_median = 0.0;
   double box_size_err_m_median = 0.0;   ///< |truth size - box size| (length, width, height)
