@@ -29,7 +29,8 @@ struct ClassScore {
 
 /// Truths hidden from the cameras now (below SceneEvalParams::min_visible_fraction): only memory
 /// (remembered parked cars, coasting tracks) can report them. seen_before counts those the cameras
-/// saw in an earlier frame of the same run (what memory could carry), and how many of them were found.
+/// saw, within the range scored, in an earlier frame of the same run (what memory could carry), and
+/// how many of them were found.
 struct HiddenScore {
   std::int64_t truths = 0, matched_truths = 0, seen_before = 0, seen_before_matched = 0;
 };
