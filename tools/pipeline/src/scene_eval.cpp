@@ -217,15 +217,15 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         for (const auto& [i, j] : m) matched[i] = used[j] = true;
         HiddenScore& hidden = cls == "car" ? out_.car_hidden : out_.pedestrian_hidden;
         for (std::size_t i = 0; i < truth.size(); ++i) {
-          if (truth_visible[i]) continue;
+          if (truth_visible[i]) {
+            seen_so_far.insert({cls, truth_id[i]});  // (a truth is listed once a frame: no other sighting of it here)
+            continue;
+          }
           const bool seen_before = seen_so_far.count({cls, truth_id[i]}) > 0;
           hidden.truths += 1;
           hidden.matched_truths += matched[i];
           hidden.seen_before += seen_before;
           hidden.seen_before_matched += seen_before && matched[i];
-        }
-        for (std::size_t i = 0; i < truth.size(); ++i) {
-          if (truth_visible[i]) seen_so_far.insert({cls, truth_id[i]});
         }
         for (std::size_t j = 0; j < det.size(); ++j) {
           if (used[j]) continue;
