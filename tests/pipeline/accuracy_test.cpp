@@ -148,21 +148,24 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // 5 m (parked_prefer_max_range_m): car P 0.894 -> 0.900, R 0.635 -> 0.659 (visible 0.701 ->
   // 0.718), pedestrian P 0.766 -> 0.787, R 0.718 -> 0.726, centre 0.225 -> 0.234 m and car yaw
   // 7.95 -> 8.35 deg (more far cars matched, the less exact ones). About 1.5 % (5 of 300
-  // sightings a scene) of margin.
+  // sightings a scene) of margin. Session 20: a remembered car is the latest view showing >= 80 %
+  // of the most seen of it (parked_keep_view_fraction), not the last sliver before it hides: car P
+  // 0.900 -> 0.902, R 0.659 -> 0.668 (visible 0.718 -> 0.724, hidden 0.30 -> 0.33), centre 0.234
+  // -> 0.238 m and car yaw 8.4 -> 8.8 deg (more remembered cars matched, boxed less closely).
   EXPECT_GE(mean.car_p, 0.885);
-  EXPECT_GE(mean.car_r, 0.645);
-  EXPECT_GE(mean.car_visible_r, 0.70);
+  EXPECT_GE(mean.car_r, 0.655);
+  EXPECT_GE(mean.car_visible_r, 0.71);
   EXPECT_GE(mean.ped_p, 0.77);
   EXPECT_GE(mean.ped_r, 0.71);
   EXPECT_GE(mean.ped_visible_r, 0.76);
-  EXPECT_LE(mean.centre_m, 0.24);
-  EXPECT_LE(mean.car_yaw_deg, 8.8);
+  EXPECT_LE(mean.centre_m, 0.245);
+  EXPECT_LE(mean.car_yaw_deg, 9.2);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
   // Session 19: of the sightings hidden now the memory finds cars 0.30 and pedestrians 0.38 (mean
   // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
   // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
-  EXPECT_GE(mean.car_hidden_r, 0.25);
+  EXPECT_GE(mean.car_hidden_r, 0.28);  // 0.33 since session 20's parked_keep_view_fraction
   EXPECT_GE(mean.ped_hidden_r, 0.30);
 }
 

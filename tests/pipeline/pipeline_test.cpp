@@ -310,6 +310,53 @@ TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
   EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
 }
 
+// The van's remembered obstacle (num_points 0) once it is out of view, after 4 frames of it whole
+// and then less of it each second down to its first 2.5 m (the field of view's edge cutting it, as
+// when the vehicle drives past): beyond parked_prefer_max_range_m, so the cut views keep their own (wrong) boxes.
+std::optional<planning_iface::Obstacle> RememberedVanAfterCutViews(const PipelineParams& params, float near_x) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  Pipeline pipe(calibration, params);
+  std::int64_t t = 1'000'000'000;
+  for (int k = 0; k < 4; ++k, t += 100'000'000) {
+    pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + 6.0f, near_x)}, std::nullopt, std::nullopt);
+  }
+  int k = 4;
+  for (float seen_m = 5.5f; seen_m >= 2.5f; seen_m -= 0.5f, ++k, t += 1'000'000'000) {
+    pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + seen_m, near_x)}, std::nullopt, std::nullopt);
+  }
+  RigInput gone = SyntheticRig(1, t);  // out of view: nothing seen there, nor the ground under it
+  gone.rig_id = 0;
+  HideGround(&gone.cloud, near_x - 0.1f, near_x + 6.1f);
+  const FrameResult r = pipe.ProcessClouds(t, k, {gone}, std::nullopt, std::nullopt);
+  for (const auto& o : r.obstacles.obstacles) {
+    if (o.class_name == "car" && o.num_points == 0) return o;
+  }
+  return std::nullopt;
+}
+
+TEST(PipelineTest, ARememberedCarKeepsTheViewThatShowedMostOfIt) {
+  PipelineParams params;
+  const float near_x = static_cast<float>(params.parked_prefer_max_range_m) + 1.0f;
+  PipelineParams latest_view = params;
+  latest_view.parked_keep_view_fraction = 0.0;
+  const auto latest = RememberedVanAfterCutViews(latest_view, near_x);
+  ASSERT_TRUE(latest.has_value()) << "the van must be remembered for this test";
+  const double latest_offset = std::hypot(latest->center_m.x() - (near_x + 3.0), latest->center_m.y());
+  const auto kept = RememberedVanAfterCutViews(params, near_x);
+  ASSERT_TRUE(kept.has_value()) << "the van was forgotten";
+  const double kept_offset = std::hypot(kept->center_m.x() - (near_x + 3.0), kept->center_m.y());
+  std::printf("FIGURE remembered van after cut views: latest view %.2f m off (%.2f m long), the latest showing >= "
+              "80 %% of the most %.2f m off (%.2f m long)\n",
+              latest_offset, latest->size_m.x(), kept_offset, kept->size_m.x());
+  ASSERT_GT(latest_offset, 0.5) << "remembering the latest (cut) view must put the van off for this test";
+  // Kept: the view of 5 of its 6 m (>= 80 % of the whole view's points x range^2; 4.5 m is not),
+  // completed from the end seen: measured 0.25 m off and 5.26 m long. A cut of 1 m moves the
+  // completed centre by at most half of it.
+  EXPECT_LE(kept_offset, 0.5 * latest_offset);
+  EXPECT_LE(kept_offset, 0.35);
+  EXPECT_GE(kept->size_m.x(), 5.0);
+}
+
 // Beyond PipelineParams::parked_prefer_max_range_m a car seen now keeps its own box: a memory
 // formed as far away is no better than the view now, and one formed wrong (two car ends in a row
 // bridged by stereo, boxed between them) would take every later view of either car for itself.
@@ -686,6 +733,9 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.parked_standing_points_ratio = std::nan("");
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_standing_points_ratio = 50.0;
+  params.parked_keep_view_fraction = -0.5;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_keep_view_fraction = 0.8;
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;

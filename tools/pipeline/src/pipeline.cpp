@@ -237,11 +237,13 @@ void PipelineParams::Validate() const {
     Fail("pipeline: box_trim_fraction must be in [0, 0.25], got " + std::to_string(box_trim_fraction));
   }
   if (parked_free_ground_points < 0 || !(parked_max_speed_mps >= 0) || !(parked_footprint_margin_m >= 0) ||
-      !(parked_max_range_m > 0) || !(parked_standing_points_ratio >= 0 && std::isfinite(parked_standing_points_ratio))) {
+      !(parked_max_range_m > 0) || !(parked_standing_points_ratio >= 0 && std::isfinite(parked_standing_points_ratio)) ||
+      !(parked_keep_view_fraction >= 0 && std::isfinite(parked_keep_view_fraction))) {
     Fail("pipeline: parked_* out of range (ground points " + std::to_string(parked_free_ground_points) +
          " >= 0, speed " + std::to_string(parked_max_speed_mps) + " m/s >= 0, margin " +
          std::to_string(parked_footprint_margin_m) + " m >= 0, range " + std::to_string(parked_max_range_m) +
-         " m > 0, standing points ratio " + std::to_string(parked_standing_points_ratio) + " finite >= 0)");
+         " m > 0, standing points ratio " + std::to_string(parked_standing_points_ratio) +
+         " finite >= 0, keep view fraction " + std::to_string(parked_keep_view_fraction) + " finite >= 0)");
   }
   if (!(parked_prefer_offset_m >= 0) || !(parked_prefer_max_range_m >= 0)) {
     Fail("pipeline: parked_prefer_* out of range (offset " + std::to_string(parked_prefer_offset_m) +
@@ -323,8 +325,15 @@ class Pipeline::Impl {
     for (const std::string& name : p.stacked_merge_classes) stacked_classes.push_back(atlas.Require(name));
   }
 
+  // Drops a remembered car with the record of how much of it was seen (a track remembered again
+  // starts afresh).
+  std::map<int, objects::Detection>::iterator ForgetParkedCar(std::map<int, objects::Detection>::iterator it) {
+    parked_view_area.erase(it->first);
+    return parked.erase(it);
+  }
   // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
-  void RememberParkedCars(const std::vector<objects::Track>& tracks, const std::vector<objects::Detection>& detections) {
+  void RememberParkedCars(const FrameResult& r, const std::vector<objects::Track>& tracks,
+                          const std::vector<objects::Detection>& detections) {
     if (params.parked_free_ground_points <= 0 || car_class < 0) return;
     for (const objects::Track& tr : tracks) {
       const int i = tr.detection_index;
@@ -335,14 +344,21 @@ class Pipeline::Impl {
       }
       objects::Detection car = detections[static_cast<std::size_t>(i)];
       car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
+      const auto index = static_cast<std::size_t>(i);
+      const double view_area = static_cast<double>(r.blobs[index].size()) * r.boxes[index].center.head<2>().squaredNorm();
+      const auto most_seen = parked_view_area.find(tr.id);
+      if (most_seen != parked_view_area.end() && view_area < params.parked_keep_view_fraction * most_seen->second) {
+        continue;
+      }
       // The same car remembered under an earlier track (an ID switch, or a replay looping back)
       // is replaced, not listed twice.
       for (auto it = parked.begin(); it != parked.end();) {
         const bool same_car = it->first != tr.id && (it->second.xy_m - car.xy_m).norm() <
                                                         0.5 * std::max(it->second.length_m, car.length_m);
-        it = same_car ? parked.erase(it) : std::next(it);
+        it = same_car ? ForgetParkedCar(it) : std::next(it);
       }
       parked[tr.id] = car;
+      parked_view_area[tr.id] = std::max(view_area, parked_view_area[tr.id]);
     }
   }
 
@@ -374,7 +390,7 @@ class Pipeline::Impl {
             objects_inside(xy, yaw, 0.5 * d.length_m + m, 0.5 * d.width_m + m) >=
                 params.parked_standing_points_ratio * ground);
       if (ground_seen || xy.norm() > params.parked_max_range_m) {
-        it = parked.erase(it);
+        it = ForgetParkedCar(it);
         continue;
       }
       bool seen_now = false;
@@ -811,6 +827,7 @@ class Pipeline::Impl {
   int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
   int pedestrian_class = atlas.Find("pedestrian");
   std::map<int, objects::Detection> parked;  // world frame, by track id
+  std::map<int, double> parked_view_area;    // of the view each remembers (parked_keep_view_fraction)
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
@@ -1175,7 +1192,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     r.obstacles.obstacles.push_back(o);
   }
 
-  s.RememberParkedCars(r.tracks, detections);
+  s.RememberParkedCars(r, r.tracks, detections);
   const std::vector<std::pair<int, objects::Detection>> hidden_cars = s.HiddenParkedCars(r);
   for (const auto& [id, d] : hidden_cars) {
     // num_points 0: not measured now
