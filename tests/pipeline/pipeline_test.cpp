@@ -273,15 +273,21 @@ RigInput ParkedVanScene(std::int64_t stamp_ns, float seen_to_x, float near_x = 4
   return in;
 }
 
-// The cars seen last (measured now) after the van @p near_x ahead was seen whole for 4 frames
-// (remembered: centre near_x + 3 m, 6 x 1.8 m along x), then only its first 2.5 m.
+// Feeds @p pipe 4 frames (0-3, 0.1 s apart from *t on) of the van @p near_x ahead seen whole
+// (remembered: centre near_x + 3 m, 6 x 1.8 m along x); *t is then the next frame's stamp.
+void SeeTheVanWhole(Pipeline& pipe, float near_x, std::int64_t* t) {
+  for (int k = 0; k < 4; ++k, *t += 100'000'000) {
+    pipe.ProcessClouds(*t, k, {ParkedVanScene(*t, near_x + 6.0f, near_x)}, std::nullopt, std::nullopt);
+  }
+}
+
+// The cars seen last (measured now) after the van @p near_x ahead was seen whole, then only its
+// first 2.5 m.
 std::vector<planning_iface::Obstacle> CarsAfterAPartialView(const PipelineParams& params, float near_x) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, params);
   std::int64_t t = 1'000'000'000;
-  for (int k = 0; k < 4; ++k, t += 100'000'000) {
-    pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + 6.0f, near_x)}, std::nullopt, std::nullopt);
-  }
+  SeeTheVanWhole(pipe, near_x, &t);
   const FrameResult r =
       pipe.ProcessClouds(t, 4, {ParkedVanScene(t, near_x + 2.5f, near_x)}, std::nullopt, std::nullopt);
   std::vector<planning_iface::Obstacle> measured;
@@ -310,16 +316,15 @@ TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
   EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
 }
 
-// The van's remembered obstacle (num_points 0) once it is out of view, after 4 frames of it whole
-// and then less of it each second down to its first 2.5 m (the field of view's edge cutting it, as
-// when the vehicle drives past): beyond parked_prefer_max_range_m, so the cut views keep their own (wrong) boxes.
+// The van's remembered obstacle (num_points 0) once it is out of view, after it was seen whole and
+// then less of it each second down to its first 2.5 m (the field of view's edge cutting it, as
+// when the vehicle drives past): beyond parked_prefer_max_range_m, so the cut views keep their own
+// (wrong) boxes.
 std::optional<planning_iface::Obstacle> RememberedVanAfterCutViews(const PipelineParams& params, float near_x) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, params);
   std::int64_t t = 1'000'000'000;
-  for (int k = 0; k < 4; ++k, t += 100'000'000) {
-    pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + 6.0f, near_x)}, std::nullopt, std::nullopt);
-  }
+  SeeTheVanWhole(pipe, near_x, &t);
   int k = 4;
   for (float seen_m = 5.5f; seen_m >= 2.5f; seen_m -= 0.5f, ++k, t += 1'000'000'000) {
     pipe.ProcessClouds(t, k, {ParkedVanScene(t, near_x + seen_m, near_x)}, std::nullopt, std::nullopt);

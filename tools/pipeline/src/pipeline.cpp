@@ -345,7 +345,8 @@ class Pipeline::Impl {
       objects::Detection car = detections[static_cast<std::size_t>(i)];
       car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
       const auto index = static_cast<std::size_t>(i);
-      const double view_area = static_cast<double>(r.blobs[index].size()) * r.boxes[index].center.head<2>().squaredNorm();
+      const double view_area =
+          static_cast<double>(r.blobs[index].size()) * r.boxes[index].center.head<2>().squaredNorm();
       const auto most_seen = parked_view_area.find(tr.id);
       if (most_seen != parked_view_area.end() && view_area < params.parked_keep_view_fraction * most_seen->second) {
         continue;

@@ -132,15 +132,6 @@ struct PipelineParams {
   double parked_max_speed_mps = 0.5;
   double parked_footprint_margin_m = 0.3;
   double parked_max_range_m = 25.0;
-  /// A remembered car is the latest view of it that showed at least parked_keep_view_fraction of
-  /// the most any view showed (points x squared range: the surface seen), not simply the latest:
-  /// the last views before a car goes behind the one in front, or out of the field of view, are
-  /// slivers, completed wrong. Simulated scene, pooled: seeds 1-5 cars 0.896 / 0.660 -> 0.898 /
-  /// 0.669 (precision / recall), seeds 6-10 0.877 / 0.672 -> 0.879 / 0.682, pedestrians and slots
-  /// alike; the median centre error 0.233 -> 0.236 m and 0.244 -> 0.255 m, the memory now finding
-  /// more hidden cars (68 -> 73 and 77 -> 85), boxed less closely than cars in view. (A car that
-  /// moves off is forgotten by the ground seen where it stood.) 0 = always the latest view.
-  double parked_keep_view_fraction = 0.8;
   /// ... unless the objects seen now hold at least this many points per such ground point inside
   /// its footprint (grown by the margin): a neighbour beside the vehicle during the sideways entry
   /// shows its side wall (tens of thousands of points) while stereo puts a hundred mismatches of
@@ -150,6 +141,15 @@ struct PipelineParams {
   /// 7, false cars there 28 -> 10; seeds 1-5 car precision 0.878 -> 0.894, recall 0.630 -> 0.635
   /// (seeds 6-10: 0.868 -> 0.878, 0.650 -> 0.649). 0 turns the exception off.
   double parked_standing_points_ratio = 50.0;
+  /// A remembered car is the latest view of it that showed at least parked_keep_view_fraction of
+  /// the most any view showed (points x squared range: the surface seen), not simply the latest:
+  /// the last views before a car goes behind the one in front, or out of the field of view, are
+  /// slivers, completed wrong. Simulated scene, pooled: seeds 1-5 cars 0.896 / 0.660 -> 0.898 /
+  /// 0.669 (precision / recall), seeds 6-10 0.877 / 0.672 -> 0.879 / 0.682, pedestrians and slots
+  /// alike; the median centre error 0.233 -> 0.236 m and 0.244 -> 0.255 m, the memory now finding
+  /// more hidden cars (68 -> 73 and 77 -> 85), boxed less closely than cars in view. (A car that
+  /// moves off is forgotten by the ground seen where it stood.) 0 = always the latest view.
+  double parked_keep_view_fraction = 0.8;
   /// A car seen now with at least this fraction of its points inside a remembered parked car's
   /// footprint (grown by parked_footprint_margin_m) takes that footprint when its own completed
   /// box's centre is more than parked_prefer_offset_m away: the neighbours beside the vehicle
