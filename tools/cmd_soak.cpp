@@ -45,12 +45,15 @@ struct Sample {
   std::int64_t loop = 0;    // times the recording had started over when the frame came out
 };
 
-// Mean tracks held per frame over the first and the last loop wholly inside the measured window:
+// Mean tracks held per frame over the first and the last loops wholly inside the measured window:
 // every loop replays the same frames, so state that is never pruned shows as a difference that no
 // host load can cause (unlike the time slopes).
 struct TracksPerLoop {
-  double first = 0.0, last = 0.0;
-  std::int64_t loops_compared = 0;
+  double first = 0.0, last = 0.0;  // of the first and last whole loop
+  // Of the first and last loops_averaged whole loops: one loop's mean moves by a track or two
+  // with what the loop before left coasting and remembered.
+  double first_mean = 0.0, last_mean = 0.0;
+  std::int64_t loops_compared = 0, loops_averaged = 0;
 };
 
 TracksPerLoop CompareLoops(const std::vector<Sample>& measured) {
@@ -70,6 +73,12 @@ TracksPerLoop CompareLoops(const std::vector<Sample>& measured) {
   result.first = mean_of(first);
   result.last = mean_of(last);
   result.loops_compared = last - first + 1;
+  constexpr std::int64_t kLoopsAveraged = 5;
+  result.loops_averaged = std::min(kLoopsAveraged, result.loops_compared / 2 + result.loops_compared % 2);
+  for (std::int64_t k = 0; k < result.loops_averaged; ++k) {
+    result.first_mean += mean_of(first + k) / static_cast<double>(result.loops_averaged);
+    result.last_mean += mean_of(last - k) / static_cast<double>(result.loops_averaged);
+  }
   return result;
 }
 
@@ -230,13 +239,15 @@ void Soak(const SoakOptions& o) {
                   "  \"rss_mb\": {\"first\": %.2f, \"last\": %.2f, \"max\": %.2f, \"mean\": %.2f, \"slope_mb_per_min\": %.4f},\n"
                   "  \"latency_ms\": {\"mean\": %.2f, \"p50\": %.2f, \"p95\": %.2f, \"slope_ms_per_min\": %.4f},\n"
                   "  \"cpu_ms_per_frame\": {\"mean\": %.2f, \"slope_ms_per_min\": %.4f},\n"
-                  "  \"tracks_per_frame\": {\"first_loop\": %.3f, \"last_loop\": %.3f, \"loops_compared\": %lld}\n}\n",
+                  "  \"tracks_per_frame\": {\"first_loop\": %.3f, \"last_loop\": %.3f, \"loops_compared\": %lld, "
+                  "\"first_loops_mean\": %.3f, \"last_loops_mean\": %.3f, \"loops_averaged\": %lld}\n}\n",
                   JsonEscape(o.log).c_str(), wall_s, o.warmup_s, static_cast<long long>(stats.frames), measured.size(),
                   static_cast<long long>(looped.loops()), static_cast<long long>(stats.skipped_out_of_order),
                   measured.front().rss_mb, measured.back().rss_mb,
                   *std::max_element(rss_values.begin(), rss_values.end()), rss.mean, rss.slope, latency.mean,
                   Percentile(latencies, 0.5), Percentile(latencies, 0.95), latency.slope, cpu.mean, cpu.slope, tracks.first, tracks.last,
-                  static_cast<long long>(tracks.loops_compared));
+                  static_cast<long long>(tracks.loops_compared), tracks.first_mean, tracks.last_mean,
+                  static_cast<long long>(tracks.loops_averaged));
     json << text;
   }
   cv::Mat plot(3 * 260 + 20, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
