@@ -50,13 +50,11 @@ struct PipelineParams {
   /// Blobs whose smallest rectangle is at least this long take the heading whose rectangle sides
   /// the points lie closest to (HeadingCriterion::kEdgeCloseness: a car's end face and the part
   /// of its side seen obliquely); smaller ones (people) keep the smallest rectangle. 0 = off, the
-  /// default: on the simulated scene (seeds 1-5, 1.5 m) it cuts the car yaw error from 9.2 to
-  /// 4.5 deg and the box centre error from 0.225 to 0.209 m, but costs car recall 0.585 -> 0.566
-  /// and pedestrian precision 0.710 -> 0.681, and a millimetre's change in the points (the int16
+  /// default: on the simulated scene (pooled seeds 1-5, session 21, 1.5 m / off) it gives car yaw
+  /// 2.5 / 7.7 deg and box centre 0.201 / 0.236 m, but cars 0.887 / 0.634 against 0.898 / 0.669
+  /// and pedestrian precision 0.721 / 0.787; and a millimetre's change in the points (the int16
   /// mm of rig clouds over LCM) moves a bay's heading by up to 2 degrees where the smallest
-  /// rectangle moves it by under 1. Re-measured in session 21 (pooled seeds 1-5, 1.5 m / off):
-  /// car yaw 2.5 / 7.7 deg and box centre 0.201 / 0.236 m, but cars 0.887 / 0.634 against
-  /// 0.898 / 0.669 and pedestrian precision 0.721 / 0.787. The smallest rectangle of an L whose
+  /// rectangle moves it by under 1. The smallest rectangle of an L whose
   /// legs are alike (a car's end and the part of its side seen at a corner) is about as small
   /// laid diagonally as along the car, so 5 m away car boxes come out 25-50 deg off; headed
   /// right, the same views (a 1.9 x 1.0 m L seen 55 deg off the car's length) no longer read as
