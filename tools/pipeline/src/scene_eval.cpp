@@ -311,6 +311,17 @@ void Scorer::Add(const std::string& log_path, int log_index) {
           ++out_.slot_found_frames;
           slot_center_.push_back(best);
           slot_yaw_.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
+        } else {
+          SceneSlotMiss miss;
+          miss.log = log_index;
+          miss.frame = frame_index;
+          miss.bay_id = bay.id;
+          miss.x_m = bay_v.x();
+          miss.y_m = bay_v.y();
+          miss.slot_near = found != nullptr;
+          miss.slot_m = found != nullptr ? best : 0.0;
+          miss.slot_reason = found != nullptr ? found->reason : "";
+          out_.slot_misses.push_back(miss);
         }
       }
     }
@@ -326,6 +337,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
 SceneEval Scorer::Finish() {
   SceneEval out = out_;
   out.range_m = params_.range_m;
+  out.slot_match_m = params_.slot_match_m;
   // Visibility needs every log's calibration: scores over some of the logs would read as all.
   out.visibility_scored = out.logs > 0 && calibrated_logs_ == out.logs;
   if (!out.visibility_scored) {
@@ -462,6 +474,14 @@ std::string SceneEval::MissesText() const {
       << " m away";
     if (a.inside_truth_id >= 0) t << ", inside " << a.inside_truth_class << " " << a.inside_truth_id;
     t << "\n";
+  }
+  for (const SceneSlotMiss& m : slot_misses) {
+    t << Where(logs, m.log, m.frame) << " bay " << m.bay_id << " at (" << m.x_m << ", " << m.y_m << ") m not found: ";
+    if (m.slot_near) {
+      t << "the slot " << m.slot_m << " m from it infeasible (" << m.slot_reason << ")\n";
+    } else {
+      t << "no slot within " << slot_match_m << " m\n";
+    }
   }
   return t.str();
 }

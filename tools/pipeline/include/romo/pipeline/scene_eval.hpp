@@ -66,10 +66,23 @@ struct SceneFalseAlarm {
   std::string inside_truth_class;
 };
 
+/// A feasible bay fully visible in a frame where no feasible slot was reported at it: what was
+/// reported nearest to it instead.
+struct SceneSlotMiss {
+  int log = 0;
+  std::int64_t frame = 0;
+  int bay_id = -1;
+  double x_m = 0.0, y_m = 0.0;  ///< bay centre, vehicle frame
+  bool slot_near = false;       ///< a slot was reported within SceneEvalParams::slot_match_m
+  double slot_m = 0.0;          ///< its target's distance from the bay centre
+  std::string slot_reason;      ///< why it was reported infeasible
+};
+
 struct SceneEval {
   std::int64_t frames = 0;
   std::int64_t logs = 0;  ///< runs pooled (counts summed, medians over all matches)
   double range_m = 15.0;  ///< SceneEvalParams::range_m scored within
+  double slot_match_m = 1.0;  ///< SceneEvalParams::slot_match_m
   ClassScore car, pedestrian;  ///< every truth within range
   /// Only truths the cameras can see (needs the calibration in the log: visibility_scored).
   ClassScore car_visible, pedestrian_visible;
@@ -87,11 +100,13 @@ struct SceneEval {
   std::int64_t narrow_reported_feasible = 0;
   std::vector<SceneMiss> misses;  ///< visible truths missed (only when visibility_scored)
   std::vector<SceneFalseAlarm> false_alarms;  ///< unmatched detections (only when visibility_scored)
+  std::vector<SceneSlotMiss> slot_misses;  ///< visible feasible bays not found
   /// {"frames":N, "car":{...}, ...} exactly as the issue specifies.
   std::string ToJson() const;
   std::string ToText() const;
   /// One line per miss (frame, class, where, visibility, the nearest detection), then one per
-  /// false alarm (where, size, the nearest truth).
+  /// false alarm (where, size, the nearest truth), then one per visible feasible bay not found
+  /// (where, the nearest slot reported and why it was infeasible).
   std::string MissesText() const;
 };
 
