@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <tuple>
@@ -110,6 +111,12 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     }
     EXPECT_EQ(static_cast<std::int64_t>(e.misses.size()), missed);
     EXPECT_EQ(static_cast<std::int64_t>(e.false_alarms.size()), false_alarms);
+    // ... and each frame whose fully visible feasible bay was not found.
+    EXPECT_EQ(static_cast<std::int64_t>(e.slot_misses.size()), e.slot_visible_frames - e.slot_found_frames);
+    for (const SceneSlotMiss& m : e.slot_misses) {
+      EXPECT_LE(std::hypot(m.x_m, m.y_m), SceneEvalParams{}.bay_visible_range_m);
+      EXPECT_EQ(m.slot_near, !m.slot_reason.empty()) << "a slot near the bay is listed only when infeasible";
+    }
     // Every sighting is either visible or hidden now, and found or not in both tallies alike.
     for (const auto& [all, visible, hidden] : {std::tie(e.car, e.car_visible, e.car_hidden),
                                                std::tie(e.pedestrian, e.pedestrian_visible, e.pedestrian_hidden)}) {

@@ -817,7 +817,8 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   if (detections > 0) {
     EXPECT_NEAR(std::stod(m[1]), matched_detections / detections, 1e-3) << json.out;
   }
-  // --misses: after the summary, one line per missed or false sighting, each naming its frame.
+  // --misses: after the summary, one line per missed or false sighting or bay not found, each
+  // naming its frame.
   const auto misses = romo::test::RunRomo("eval scene --misses --log " + (dir / "outputs.lcmlog"));
   EXPECT_EQ(misses.exit_code, 0) << misses.err;
   const std::size_t listed = misses.out.find("\nframe ");
@@ -826,7 +827,9 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   for (std::string line; std::getline(lines, line);) {
     if (line.empty()) continue;
     EXPECT_EQ(line.rfind("frame ", 0), 0u) << line;
-    EXPECT_TRUE(line.find(" car ") != std::string::npos || line.find(" pedestrian ") != std::string::npos) << line;
+    EXPECT_TRUE(line.find(" car ") != std::string::npos || line.find(" pedestrian ") != std::string::npos ||
+                line.find(" bay ") != std::string::npos)
+        << line;
   }
   // A recording without calibration is refused with a clear message.
   romo::test::WriteFile(dir / "empty.lcmlog", "");
