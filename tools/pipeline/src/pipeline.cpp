@@ -4,7 +4,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <map>
 #include <optional>
@@ -339,12 +338,10 @@ class Pipeline::Impl {
     for (const objects::Track& tr : tracks) {
       const int i = tr.detection_index;
       if (tr.state != objects::TrackState::kConfirmed || i < 0 || tr.merged || tr.class_index != car_class ||
-          detections[static_cast<std::size_t>(i)].classification.class_index != car_class) {
+          detections[static_cast<std::size_t>(i)].classification.class_index != car_class ||
+          tr.velocity_mps.norm() > params.parked_max_speed_mps) {
         continue;
       }
-      static const double x_psk = std::getenv("X_PSK") ? std::atof(std::getenv("X_PSK")) : 0.0;  // EXPERIMENT
-      const double jitter = x_psk > 0 ? DepthSpread(r.cloud.sigma_z_m, r.blobs[static_cast<std::size_t>(i)], params.box_trim_fraction) : 0.0;
-      if (tr.velocity_mps.norm() > params.parked_max_speed_mps + x_psk * jitter) continue;
       objects::Detection car = detections[static_cast<std::size_t>(i)];
       car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
       const auto index = static_cast<std::size_t>(i);
