@@ -159,20 +159,25 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // of the most seen of it (parked_keep_view_fraction), not the last sliver before it hides: car P
   // 0.900 -> 0.902, R 0.659 -> 0.668 (visible 0.718 -> 0.724, hidden 0.30 -> 0.33), centre 0.234
   // -> 0.238 m and car yaw 8.4 -> 8.8 deg (more remembered cars matched, boxed less closely).
-  EXPECT_GE(mean.car_p, 0.885);
-  EXPECT_GE(mean.car_r, 0.655);
-  EXPECT_GE(mean.car_visible_r, 0.71);
+  // Session 22: the parked-car speed gate grows with the blob's depth noise, and such views never
+  // replace a memory from a steady one (parked_speed_per_depth_spread): car P 0.902 -> 0.928, R
+  // 0.668 -> 0.735 (visible 0.724 -> 0.778, hidden 0.33 -> 0.47), pedestrians alike, centre 0.238
+  // -> 0.244 m and car yaw 8.8 -> 11.1 deg: the far cars now remembered and matched are headed
+  // worst (their views 25-50 deg off, README), no box seen before got worse.
+  EXPECT_GE(mean.car_p, 0.91);
+  EXPECT_GE(mean.car_r, 0.72);
+  EXPECT_GE(mean.car_visible_r, 0.76);
   EXPECT_GE(mean.ped_p, 0.77);
   EXPECT_GE(mean.ped_r, 0.71);
   EXPECT_GE(mean.ped_visible_r, 0.76);
-  EXPECT_LE(mean.centre_m, 0.245);
-  EXPECT_LE(mean.car_yaw_deg, 9.2);
+  EXPECT_LE(mean.centre_m, 0.25);
+  EXPECT_LE(mean.car_yaw_deg, 11.8);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
   // Session 19: of the sightings hidden now the memory finds cars 0.30 and pedestrians 0.38 (mean
   // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
   // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
-  EXPECT_GE(mean.car_hidden_r, 0.28);  // 0.33 since session 20's parked_keep_view_fraction
+  EXPECT_GE(mean.car_hidden_r, 0.42);  // 0.33 since session 20, 0.47 since session 22
   EXPECT_GE(mean.ped_hidden_r, 0.30);
 }
 

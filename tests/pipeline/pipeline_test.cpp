@@ -741,6 +741,11 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.parked_keep_view_fraction = -0.5;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_keep_view_fraction = 0.8;
+  params.parked_speed_per_depth_spread = -0.25;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_speed_per_depth_spread = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_speed_per_depth_spread = 0.25;
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -236,6 +237,10 @@ void PipelineParams::Validate() const {
   if (!(box_trim_fraction >= 0 && box_trim_fraction <= 0.25f)) {
     Fail("pipeline: box_trim_fraction must be in [0, 0.25], got " + std::to_string(box_trim_fraction));
   }
+  if (!(parked_speed_per_depth_spread >= 0 && std::isfinite(parked_speed_per_depth_spread))) {
+    Fail("pipeline: parked_speed_per_depth_spread must be finite and >= 0, got " +
+         std::to_string(parked_speed_per_depth_spread));
+  }
   if (parked_free_ground_points < 0 || !(parked_max_speed_mps >= 0) || !(parked_footprint_margin_m >= 0) ||
       !(parked_max_range_m > 0) || !(parked_standing_points_ratio >= 0 && std::isfinite(parked_standing_points_ratio)) ||
       !(parked_keep_view_fraction >= 0 && std::isfinite(parked_keep_view_fraction))) {
@@ -329,6 +334,7 @@ class Pipeline::Impl {
   // starts afresh).
   std::map<int, objects::Detection>::iterator ForgetParkedCar(std::map<int, objects::Detection>::iterator it) {
     parked_view_area.erase(it->first);
+    parked_from_steady_view.erase(it->first);
     return parked.erase(it);
   }
   // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
@@ -338,19 +344,27 @@ class Pipeline::Impl {
     for (const objects::Track& tr : tracks) {
       const int i = tr.detection_index;
       if (tr.state != objects::TrackState::kConfirmed || i < 0 || tr.merged || tr.class_index != car_class ||
-          detections[static_cast<std::size_t>(i)].classification.class_index != car_class ||
-          tr.velocity_mps.norm() > params.parked_max_speed_mps) {
+          detections[static_cast<std::size_t>(i)].classification.class_index != car_class) {
+        continue;
+      }
+      const auto index = static_cast<std::size_t>(i);
+      const double speed = tr.velocity_mps.norm();
+      const bool steady = speed <= params.parked_max_speed_mps;
+      if (!steady && (params.parked_speed_per_depth_spread <= 0.0 ||
+                      speed > params.parked_max_speed_mps +
+                                  params.parked_speed_per_depth_spread *
+                                      DepthSpread(r.cloud.sigma_z_m, r.blobs[index], params.box_trim_fraction))) {
         continue;
       }
       objects::Detection car = detections[static_cast<std::size_t>(i)];
       car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
-      const auto index = static_cast<std::size_t>(i);
       const double view_area =
           static_cast<double>(r.blobs[index].size()) * r.boxes[index].center.head<2>().squaredNorm();
       const auto most_seen = parked_view_area.find(tr.id);
       if (most_seen != parked_view_area.end() && view_area < params.parked_keep_view_fraction * most_seen->second) {
         continue;
       }
+      if (!steady && parked_from_steady_view.count(tr.id) > 0) continue;
       // The same car remembered under an earlier track (an ID switch, or a replay looping back)
       // is replaced, not listed twice.
       for (auto it = parked.begin(); it != parked.end();) {
@@ -360,6 +374,7 @@ class Pipeline::Impl {
       }
       parked[tr.id] = car;
       parked_view_area[tr.id] = std::max(view_area, parked_view_area[tr.id]);
+      if (steady) parked_from_steady_view.insert(tr.id);
     }
   }
 
@@ -829,6 +844,7 @@ class Pipeline::Impl {
   int pedestrian_class = atlas.Find("pedestrian");
   std::map<int, objects::Detection> parked;  // world frame, by track id
   std::map<int, double> parked_view_area;    // of the view each remembers (parked_keep_view_fraction)
+  std::set<int> parked_from_steady_view;     // remembered under parked_max_speed_mps (not replaced by others)
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
