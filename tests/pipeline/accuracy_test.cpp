@@ -163,13 +163,16 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // replace a memory from a steady one (parked_speed_per_depth_spread): car P 0.902 -> 0.928, R
   // 0.668 -> 0.735 (visible 0.724 -> 0.778, hidden 0.33 -> 0.47), pedestrians alike, centre 0.238
   // -> 0.244 m and car yaw 8.8 -> 11.1 deg: the far cars now remembered and matched are headed
-  // worst (their views 25-50 deg off, README), no box seen before got worse.
+  // worst (their views 25-50 deg off, README), no box seen before got worse. Session 23: a
+  // pedestrian track whose blob is too low for a person (legs hidden) stays a pedestrian
+  // (pedestrian_tracks_keep_partial_views), pieces inside a remembered car are no people while a
+  // car detection stands in it too: pedestrian P 0.791 -> 0.795, R 0.726 -> 0.751 (visible 0.802).
   EXPECT_GE(mean.car_p, 0.91);
   EXPECT_GE(mean.car_r, 0.72);
   EXPECT_GE(mean.car_visible_r, 0.76);
-  EXPECT_GE(mean.ped_p, 0.77);
-  EXPECT_GE(mean.ped_r, 0.71);
-  EXPECT_GE(mean.ped_visible_r, 0.76);
+  EXPECT_GE(mean.ped_p, 0.78);
+  EXPECT_GE(mean.ped_r, 0.74);
+  EXPECT_GE(mean.ped_visible_r, 0.79);
   EXPECT_LE(mean.centre_m, 0.25);
   EXPECT_LE(mean.car_yaw_deg, 11.8);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);

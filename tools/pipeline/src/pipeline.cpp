@@ -356,7 +356,7 @@ class Pipeline::Impl {
                                       DepthSpread(r.cloud.sigma_z_m, r.blobs[index], params.box_trim_fraction))) {
         continue;
       }
-      objects::Detection car = detections[static_cast<std::size_t>(i)];
+      objects::Detection car = detections[index];
       car.xy_m = tr.xy_m;  // the track's filtered position: steadier than one view
       const double view_area =
           static_cast<double>(r.blobs[index].size()) * r.boxes[index].center.head<2>().squaredNorm();
@@ -495,17 +495,12 @@ class Pipeline::Impl {
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
     return seen;
   }
-  // Pedestrian detections (world frame) inside a remembered parked car that no car detection
-  // stands in now are pieces of its end broken up by stereo (PipelineParams::
-  // parked_pieces_unclassified): of no class, and their tracks' votes do not make them people.
-  void UnclassifyPiecesOfHiddenParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
+  // Pedestrian detections (world frame) inside a remembered parked car are pieces of its end
+  // broken up by stereo (PipelineParams::parked_pieces_unclassified): of no class, and their
+  // tracks' votes do not make them people.
+  void UnclassifyPiecesOfParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
     if (!params.parked_pieces_unclassified || pedestrian_class < 0) return;
-    for (const auto& entry : parked) {
-      const objects::Detection& car = entry.second;  // (a structured binding cannot be captured in C++17)
-      const bool seen_as_car = std::any_of(detections->begin(), detections->end(), [&](const objects::Detection& d) {
-        return d.classification.class_index == car_class && (d.xy_m - car.xy_m).norm() < 0.5 * car.length_m;
-      });
-      if (seen_as_car) continue;
+    for (const auto& [car_id, car] : parked) {
       for (std::size_t i = 0; i < detections->size(); ++i) {
         objects::Detection& d = (*detections)[i];
         if (d.classification.class_index != pedestrian_class ||
@@ -516,6 +511,24 @@ class Pipeline::Impl {
         (*seen)[i].part_of_parked_car = true;
       }
     }
+  }
+
+  // @p box (measured) from the ground up, when its footprint can be a person's (Atlas length within
+  // bounds, width up to the most) and its top is no higher than a person is tall: a person partly
+  // seen (PipelineParams::pedestrian_tracks_keep_partial_views).
+  std::optional<objects::Box3> PartlySeenPerson(const FrameResult& r, const Eigen::Vector3f& up,
+                                                const objects::Box3& box) const {
+    const objects::ObjectClass& person = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
+    const float bottom = BottomHeight(r, up, box);
+    const float top = bottom + box.size.z();
+    if (!person.length.Contains(box.size.x()) || box.size.y() > person.width.max_m || top > person.height.max_m ||
+        !(top > 0.f)) {
+      return std::nullopt;
+    }
+    objects::Box3 out = box;
+    out.center -= up * (0.5f * bottom);
+    out.size.z() = top;
+    return out;
   }
 
   // Whether one of @p a, @p b stands on the ground and the other floats above it, less than
@@ -1067,7 +1080,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     detections.push_back(d);
   }
   s.PreferRememberedFootprints(r, &r.boxes, &detections);
-  s.UnclassifyPiecesOfHiddenParkedCars(&detections, &seen);
+  s.UnclassifyPiecesOfParkedCars(&detections, &seen);
   for (const objects::Detection& d : detections) {
     r.box_classes.push_back(s.atlas.classes()[static_cast<std::size_t>(d.classification.class_index)].name);
   }
@@ -1079,9 +1092,20 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   r.tracks = s.tracker.Update(t_s, detections);
   // A track's class, voted over every view of it, is steadier than one frame's: a car seen whole
   // earlier and cut by the image border or seen end-on now is completed as a car, if its measured
-  // extents can be one (a fragment too low for a car stays unknown).
+  // extents can be one (a fragment too low for a car stays unknown). A person partly seen is still
+  // the person its track says (PipelineParams::pedestrian_tracks_keep_partial_views).
   for (const objects::Track& tr : r.tracks) {
     const int i = tr.detection_index;
+    if (i >= 0 && i < static_cast<int>(r.boxes.size()) && s.params.pedestrian_tracks_keep_partial_views &&
+        s.pedestrian_class >= 0 && tr.class_index == s.pedestrian_class && !tr.merged && !seen[i].framed &&
+        !seen[i].part_of_parked_car && detections[i].classification.class_index == s.atlas.unknown_index()) {
+      if (const std::optional<objects::Box3> person = s.PartlySeenPerson(r, up, measured_boxes[i])) {
+        r.boxes[i] = *person;
+        r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(s.pedestrian_class)].name;
+        detections[i] = world_detection(*person, {s.pedestrian_class, tr.class_score});
+        continue;
+      }
+    }
     if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground || seen[i].framed ||
         seen[i].part_of_parked_car) {
       continue;
