@@ -192,7 +192,7 @@ struct PipelineParams {
   /// floating above the ground) stays a pedestrian when the blob's footprint can be a person's and
   /// its top is no higher than one is tall; its box then reaches down to the ground. Planning
   /// must not lose a person to a partial view. Pooled pedestrians, seeds 1-5: P / R 0.795 / 0.726
-  /// -> 0.794 / 0.751; seeds 6-10: 0.765 / 0.726 -> 0.754 / 0.767 (a few tracks that had moved
+  /// -> 0.795 / 0.751; seeds 6-10: 0.765 / 0.726 -> 0.754 / 0.767 (a few tracks that had moved
   /// onto a car's piece keep calling it a person).
   bool pedestrian_tracks_keep_partial_views = true;
   /// Corner views read either side as cut off (corner_angle_deg 50): in a row of parked cars the
