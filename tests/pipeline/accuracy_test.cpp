@@ -166,13 +166,15 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // worst (their views 25-50 deg off, README), no box seen before got worse. Session 23: a
   // pedestrian track whose blob is too low for a person (legs hidden) stays a pedestrian
   // (pedestrian_tracks_keep_partial_views), pieces inside a remembered car are no people while a
-  // car detection stands in it too: pedestrian P 0.791 -> 0.795, R 0.726 -> 0.751 (visible 0.802).
+  // car detection stands in it too: pedestrian P 0.791 -> 0.795, R 0.726 -> 0.751 (visible 0.802);
+  // then within 0.5 m around it too, unless a track walked there (parked_pieces_margin_m):
+  // pedestrian P 0.795 -> 0.879, R 0.751 -> 0.745 (visible 0.797), hidden cars 0.47 -> 0.50.
   EXPECT_GE(mean.car_p, 0.91);
   EXPECT_GE(mean.car_r, 0.72);
   EXPECT_GE(mean.car_visible_r, 0.76);
-  EXPECT_GE(mean.ped_p, 0.78);
-  EXPECT_GE(mean.ped_r, 0.74);
-  EXPECT_GE(mean.ped_visible_r, 0.79);
+  EXPECT_GE(mean.ped_p, 0.86);
+  EXPECT_GE(mean.ped_r, 0.73);
+  EXPECT_GE(mean.ped_visible_r, 0.78);
   EXPECT_LE(mean.centre_m, 0.25);
   EXPECT_LE(mean.car_yaw_deg, 11.8);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);

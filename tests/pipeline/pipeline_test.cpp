@@ -442,6 +442,44 @@ TEST(PipelineTest, APersonSizedPieceInsideAHiddenParkedCarIsNoPedestrian) {
   EXPECT_EQ(classes_near(PipelineParams{}, person), four_people);
 }
 
+TEST(PipelineTest, APieceJustOutsideARememberedCarIsNoPedestrianButAPersonWhoWalkedThereIs) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  // The car 4..8.5 m ahead seen for 4 frames, then hidden. Then a person-sized column ends at
+  // (8.8, 0), 0.3 m beyond the car's end: standing there from the start (a piece of the car's end
+  // the memory boxed short), or having walked there from 12.4 m at 1.2 m/s. Its class in the last
+  // frame.
+  const Eigen::Vector2d spot(8.8, 0.0);
+  auto class_at_spot = [&](const PipelineParams& params, bool walked) {
+    Pipeline pipe(calibration, params);
+    std::int64_t t = 1'000'000'000;
+    int k = 0;
+    for (; k < 4; ++k, t += 100'000'000) {
+      pipe.ProcessClouds(t, k, {ParkedCarScene(t, true, false)}, std::nullopt, std::nullopt);
+    }
+    std::string cls = "none";
+    constexpr int kWalkFrames = 10;
+    for (int step = 0; step <= kWalkFrames + 2; ++step, ++k, t += 300'000'000) {
+      RigInput in = ParkedCarScene(t, false, false);
+      const float x = walked ? std::max(8.8f, 12.4f - 0.36f * static_cast<float>(step)) : 8.8f;
+      AddColumn(&in.cloud, {x, 0.f}, 1.7f);
+      const FrameResult r = pipe.ProcessClouds(t, k, {in}, std::nullopt, std::nullopt);
+      cls = "none";
+      for (const auto& o : r.obstacles.obstacles) {
+        if (o.num_points > 0 && (o.center_m.head<2>() - spot).norm() < 0.3) cls = o.class_name;
+      }
+    }
+    return cls;
+  };
+  PipelineParams footprint_only;
+  footprint_only.parked_pieces_margin_m = 0.0;
+  ASSERT_EQ(class_at_spot(footprint_only, false), "pedestrian") << "the piece alone must read as a person";
+  EXPECT_EQ(class_at_spot(PipelineParams{}, false), "unknown");
+  EXPECT_EQ(class_at_spot(PipelineParams{}, true), "pedestrian");
+  PipelineParams never_walked;
+  never_walked.parked_pieces_walked_m = 100.0;
+  EXPECT_EQ(class_at_spot(never_walked, true), "unknown") << "the walk, not the column, must keep the person";
+}
+
 TEST(PipelineTest, APersonWhoseLegsGoOutOfSightStaysAPedestrianBoxedFromTheGround) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   // A person 6 m ahead, seen whole in the first @p whole_frames of 6 frames, then only from 1 m
@@ -785,6 +823,14 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   params.parked_speed_per_depth_spread = std::nan("");
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_speed_per_depth_spread = 0.25;
+  params.parked_pieces_margin_m = -0.5;
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_pieces_margin_m = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_pieces_margin_m = 0.5;
+  params.parked_pieces_walked_m = std::nan("");
+  EXPECT_THROW(params.Validate(), romo::Error);
+  params.parked_pieces_walked_m = 2.0;
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;

@@ -250,6 +250,10 @@ void PipelineParams::Validate() const {
          " m > 0, standing points ratio " + std::to_string(parked_standing_points_ratio) +
          " finite >= 0, keep view fraction " + std::to_string(parked_keep_view_fraction) + " finite >= 0)");
   }
+  if (!(parked_pieces_margin_m >= 0 && std::isfinite(parked_pieces_margin_m)) || !(parked_pieces_walked_m >= 0)) {
+    Fail("pipeline: parked_pieces_* out of range (margin " + std::to_string(parked_pieces_margin_m) +
+         " m finite >= 0, walked " + std::to_string(parked_pieces_walked_m) + " m >= 0)");
+  }
   if (!(parked_prefer_offset_m >= 0) || !(parked_prefer_max_range_m >= 0)) {
     Fail("pipeline: parked_prefer_* out of range (offset " + std::to_string(parked_prefer_offset_m) +
          " m >= 0, max range " + std::to_string(parked_prefer_max_range_m) + " m >= 0)");
@@ -500,17 +504,43 @@ class Pipeline::Impl {
   // tracks' votes do not make them people.
   void UnclassifyPiecesOfParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
     if (!params.parked_pieces_unclassified || pedestrian_class < 0) return;
+    const double margin = params.parked_pieces_margin_m;
     for (const auto& [car_id, car] : parked) {
       for (std::size_t i = 0; i < detections->size(); ++i) {
         objects::Detection& d = (*detections)[i];
+        const Eigen::Vector2d offset = d.xy_m - car.xy_m;
         if (d.classification.class_index != pedestrian_class ||
-            !InsideFootprint(d.xy_m - car.xy_m, car.yaw_rad, 0.5 * car.length_m, 0.5 * car.width_m)) {
+            !InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m + margin, 0.5 * car.width_m + margin) ||
+            (!InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m, 0.5 * car.width_m) && WalkerNear(d.xy_m))) {
           continue;
         }
         d.classification = {atlas.unknown_index(), 0.0};
         (*seen)[i].part_of_parked_car = true;
       }
     }
+  }
+
+  // Whether a pedestrian track that has walked parked_pieces_walked_m from where it began stood
+  // within a person's stride (Atlas length max) of @p xy (world frame) last frame: a person who came
+  // up to a parked car, not a piece of it.
+  bool WalkerNear(const Eigen::Vector2d& xy) const {
+    const double stride = atlas.classes()[static_cast<std::size_t>(pedestrian_class)].length.max_m;
+    return std::any_of(walkers.begin(), walkers.end(),
+                       [&](const Eigen::Vector2d& w) { return (w - xy).norm() <= stride; });
+  }
+  // Remembers where each track began and which pedestrian tracks have walked (WalkerNear).
+  void NoteWalkers(const std::vector<objects::Track>& tracks) {
+    std::map<int, Eigen::Vector2d> began;
+    walkers.clear();
+    for (const objects::Track& tr : tracks) {
+      const auto it = track_began.find(tr.id);
+      const Eigen::Vector2d start = it != track_began.end() ? it->second : tr.xy_m;
+      began.emplace(tr.id, start);
+      if (tr.class_index == pedestrian_class && (tr.xy_m - start).norm() >= params.parked_pieces_walked_m) {
+        walkers.push_back(tr.xy_m);
+      }
+    }
+    track_began = std::move(began);
   }
 
   // @p box (measured) from the ground up, when its footprint can be a person's (Atlas length within
@@ -858,6 +888,8 @@ class Pipeline::Impl {
   std::map<int, objects::Detection> parked;  // world frame, by track id
   std::map<int, double> parked_view_area;    // of the view each remembers (parked_keep_view_fraction)
   std::set<int> parked_from_steady_view;     // remembered under parked_max_speed_mps (not replaced by others)
+  std::map<int, Eigen::Vector2d> track_began;  // world frame, by track id (NoteWalkers)
+  std::vector<Eigen::Vector2d> walkers;        // world frame, last frame's (NoteWalkers)
   objects::Tracker tracker;
   planning_iface::ParkingSlotEstimator slots;
   planning_iface::ManeuverStageTracker stage;
@@ -1090,6 +1122,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   t0 = Clock::now();
   const double t_s = (stamp_ns - *s.first_stamp_ns) * 1e-9;
   r.tracks = s.tracker.Update(t_s, detections);
+  s.NoteWalkers(r.tracks);
   // A track's class, voted over every view of it, is steadier than one frame's: a car seen whole
   // earlier and cut by the image border or seen end-on now is completed as a car, if its measured
   // extents can be one (a fragment too low for a car stays unknown). A person partly seen is still
