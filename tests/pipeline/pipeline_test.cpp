@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <random>
 #include <regex>
@@ -812,25 +813,21 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   EXPECT_THROW(params.Validate(), romo::Error);
   params.completion.face_min_score = 0.3;
   EXPECT_NO_THROW(params.Validate());
-  params.parked_standing_points_ratio = std::nan("");
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_standing_points_ratio = 50.0;
-  params.parked_keep_view_fraction = -0.5;
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_keep_view_fraction = 0.8;
-  params.parked_speed_per_depth_spread = -0.25;
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_speed_per_depth_spread = std::nan("");
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_speed_per_depth_spread = 0.25;
-  params.parked_pieces_margin_m = -0.5;
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_pieces_margin_m = std::nan("");
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_pieces_margin_m = 0.5;
-  params.parked_pieces_walked_m = std::nan("");
-  EXPECT_THROW(params.Validate(), romo::Error);
-  params.parked_pieces_walked_m = 2.0;
+  // Each of @p bad values of @p field is rejected; the field is left as it was.
+  const auto rejects = [&params](double& field, std::initializer_list<double> bad) {
+    const double good = field;
+    for (double value : bad) {
+      field = value;
+      EXPECT_THROW(params.Validate(), romo::Error) << value;
+    }
+    field = good;
+  };
+  rejects(params.parked_standing_points_ratio, {std::nan("")});
+  rejects(params.parked_keep_view_fraction, {-0.5});
+  rejects(params.parked_speed_per_depth_spread, {-0.25, std::nan("")});
+  rejects(params.parked_pieces_margin_m, {-0.5, std::nan("")});
+  rejects(params.parked_pieces_walked_m, {std::nan("")});
+  EXPECT_NO_THROW(params.Validate());
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);
   params.parked_free_ground_points = 20;
