@@ -499,9 +499,10 @@ class Pipeline::Impl {
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
     return seen;
   }
-  // Pedestrian detections (world frame) inside a remembered parked car are pieces of its end
-  // broken up by stereo (PipelineParams::parked_pieces_unclassified): of no class, and their
-  // tracks' votes do not make them people.
+  // Pedestrian detections (world frame) inside a remembered parked car, or within
+  // parked_pieces_margin_m around it where no walker stood, are pieces of its end broken up by
+  // stereo (PipelineParams::parked_pieces_*): of no class, and their tracks' votes do not make
+  // them people.
   void UnclassifyPiecesOfParkedCars(std::vector<objects::Detection>* detections, std::vector<Seen>* seen) const {
     if (!params.parked_pieces_unclassified || pedestrian_class < 0) return;
     const double margin = params.parked_pieces_margin_m;
