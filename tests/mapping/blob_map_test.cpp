@@ -120,7 +120,9 @@ TEST(BlobMapTest, HighConfidencePointsGiveABoxCloserToTheTruth) {
       blob.cov_world.push_back(blob.cov_world.front());
     }
     const auto upd = map.Update({blob}, cam, depth);
-    if (k > 0) EXPECT_GT(upd.matched, 100) << "frame " << k;
+    if (k > 0) {
+      EXPECT_GT(upd.matched, 100) << "frame " << k;
+    }
   }
   ASSERT_EQ(map.blobs().size(), 1u);
   const Blob& b = map.blobs().front();
@@ -291,7 +293,9 @@ TEST(BlobMapTest, SeparatingAxisTestAgreesWithPointSamplingOnRandomBoxes) {
     }
     const bool sat = a.Intersects(b);
     EXPECT_EQ(sat, b.Intersects(a)) << "pair " << k;
-    if (hit) EXPECT_TRUE(sat) << "pair " << k << ": a sampled point lies in both boxes";
+    if (hit) {
+      EXPECT_TRUE(sat) << "pair " << k << ": a sampled point lies in both boxes";
+    }
     sampled_hits += hit;
     sat_hits += sat;
   }

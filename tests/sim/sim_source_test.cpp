@@ -78,7 +78,9 @@ TEST(SimSourceTest, DeliversSixRigsVehicleStateAndGnssWithMatchingCalibration) {
     ASSERT_TRUE(set->gnss.has_value());
     EXPECT_TRUE(set->gnss->valid);
     EXPECT_NEAR(set->gnss->latitude_deg, 48.08, 0.01);
-    if (count > 0) EXPECT_EQ(set->stamp_ns - last_stamp, 100000000);  // 10 Hz
+    if (count > 0) {
+      EXPECT_EQ(set->stamp_ns - last_stamp, 100000000);  // 10 Hz
+    }
     last_stamp = set->stamp_ns;
     ++count;
   }

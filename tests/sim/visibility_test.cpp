@@ -67,7 +67,9 @@ TEST(VisibilityTest, AgreesWithTheRenderersObjectIds) {
       }
       // Nothing in any image: nothing in view (samples are a 6 x 6 grid a face, so a sliver
       // between grid points may be missed, never the reverse).
-      if (pixels[o.id] == 0) EXPECT_EQ(fraction, 0.0) << o.class_name << " " << o.id;
+      if (pixels[o.id] == 0) {
+        EXPECT_EQ(fraction, 0.0) << o.class_name << " " << o.id;
+      }
     }
   }
   std::printf("visible %d, hidden %d object sightings\n", visible, hidden);
