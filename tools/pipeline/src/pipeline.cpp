@@ -509,12 +509,12 @@ class Pipeline::Impl {
     for (const auto& [car_id, car] : parked) {
       for (std::size_t i = 0; i < detections->size(); ++i) {
         objects::Detection& d = (*detections)[i];
+        if (d.classification.class_index != pedestrian_class) continue;
         const Eigen::Vector2d offset = d.xy_m - car.xy_m;
-        if (d.classification.class_index != pedestrian_class ||
-            !InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m + margin, 0.5 * car.width_m + margin) ||
-            (!InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m, 0.5 * car.width_m) && WalkerNear(d.xy_m))) {
-          continue;
-        }
+        const bool inside = InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m, 0.5 * car.width_m);
+        const bool around =
+            InsideFootprint(offset, car.yaw_rad, 0.5 * car.length_m + margin, 0.5 * car.width_m + margin);
+        if (!inside && (!around || WalkerNear(d.xy_m))) continue;
         d.classification = {atlas.unknown_index(), 0.0};
         (*seen)[i].part_of_parked_car = true;
       }
@@ -1130,9 +1130,11 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // the person its track says (PipelineParams::pedestrian_tracks_keep_partial_views).
   for (const objects::Track& tr : r.tracks) {
     const int i = tr.detection_index;
-    if (i >= 0 && i < static_cast<int>(r.boxes.size()) && s.params.pedestrian_tracks_keep_partial_views &&
-        s.pedestrian_class >= 0 && tr.class_index == s.pedestrian_class && !tr.merged && !seen[i].framed &&
-        !seen[i].part_of_parked_car && detections[i].classification.class_index == s.atlas.unknown_index()) {
+    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || seen[i].framed || seen[i].part_of_parked_car) {
+      continue;
+    }
+    if (s.params.pedestrian_tracks_keep_partial_views && s.pedestrian_class >= 0 &&
+        tr.class_index == s.pedestrian_class && detections[i].classification.class_index == s.atlas.unknown_index()) {
       if (const std::optional<objects::Box3> person = s.PartlySeenPerson(r, up, measured_boxes[i])) {
         r.boxes[i] = *person;
         r.box_classes[i] = s.atlas.classes()[static_cast<std::size_t>(s.pedestrian_class)].name;
@@ -1140,10 +1142,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
         continue;
       }
     }
-    if (i < 0 || i >= static_cast<int>(r.boxes.size()) || tr.merged || !seen[i].on_ground || seen[i].framed ||
-        seen[i].part_of_parked_car) {
-      continue;
-    }
+    if (!seen[i].on_ground) continue;
     if (tr.class_index < 0 || tr.class_index == s.atlas.unknown_index() ||
         tr.class_index == detections[i].classification.class_index) {
       continue;
