@@ -99,6 +99,12 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     EXPECT_LE(e.slot_center_err_m, 0.15);
     EXPECT_LE(e.slot_yaw_err_deg, 3.0);
     EXPECT_EQ(e.narrow_reported_feasible, 0);
+    EXPECT_EQ(static_cast<std::int64_t>(e.narrow_feasible.size()), e.narrow_reported_feasible);
+    for (const SceneNarrowFeasible& n : e.narrow_feasible) {
+      ADD_FAILURE() << "seed " << seed << " frame " << n.frame << ": the " << n.bay_width_m
+                    << " m bay reported feasible, a slot " << n.slot_length_m << " m long between tracks " << n.prev_id
+                    << " and " << n.next_id;
+    }
     // Hidden objects (about 40 car and 25 pedestrian sightings a scene) are neither missed nor
     // found there.
     EXPECT_LT(e.car_visible.truths, e.car.truths);

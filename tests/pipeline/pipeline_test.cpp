@@ -924,6 +924,32 @@ TEST(PipelineTest, RunEndToEndWritesOutputsAndEvaluation) {
   EXPECT_NE(bad.exit_code, 0);
 }
 
+// Each frame where the too-narrow bay was reported feasible is listed with the slot behind it:
+// where, how long, between which neighbours (what to look at when the rule breaks).
+TEST(PipelineTest, MissesListEachFrameTheNarrowBayWasReportedFeasible) {
+  SceneEval e;
+  e.logs = 1;
+  SceneNarrowFeasible n;
+  n.frame = 34;
+  n.bay_id = 2;
+  n.x_m = 7.63;
+  n.y_m = 2.71;
+  n.bay_width_m = 1.89;
+  n.slot_length_m = 3.49;
+  n.prev_id = 5;
+  n.next_id = 57;
+  n.confidence = 0.95;
+  e.narrow_feasible.push_back(n);
+  e.narrow_reported_feasible = 1;
+  EXPECT_NE(e.MissesText().find("frame 34 narrow bay 2 at (7.63, 2.71) m, 1.89 m wide, reported feasible: a slot "
+                                "3.49 m long between tracks 5 and 57, confidence 0.95\n"),
+            std::string::npos)
+      << e.MissesText();
+  e.logs = 2;
+  e.narrow_feasible.front().log = 1;
+  EXPECT_NE(e.MissesText().find("log 1 frame 34 narrow bay 2"), std::string::npos) << e.MissesText();
+}
+
 // Several runs (seeds) scored as one: what each run counts adds up, and the lists name the run.
 TEST(PipelineTest, EvalScenePoolsSeveralRuns) {
   romo::test::ScratchDir dir;

@@ -302,7 +302,21 @@ void Scorer::Add(const std::string& log_path, int log_index) {
           }
         }
         if (!bay.feasible) {
-          if (found != nullptr && found->feasible) ++out_.narrow_reported_feasible;
+          if (found != nullptr && found->feasible) {
+            ++out_.narrow_reported_feasible;
+            SceneNarrowFeasible narrow;
+            narrow.log = log_index;
+            narrow.frame = frame_index;
+            narrow.bay_id = bay.id;
+            narrow.x_m = bay_v.x();
+            narrow.y_m = bay_v.y();
+            narrow.bay_width_m = bay.width_m;
+            narrow.slot_length_m = found->length_m;
+            narrow.prev_id = found->prev_id;
+            narrow.next_id = found->next_id;
+            narrow.confidence = found->confidence;
+            out_.narrow_feasible.push_back(narrow);
+          }
           continue;
         }
         if (bay_v.norm() > params_.bay_visible_range_m) continue;
@@ -482,6 +496,11 @@ std::string SceneEval::MissesText() const {
     } else {
       t << "no slot within " << slot_match_m << " m\n";
     }
+  }
+  for (const SceneNarrowFeasible& n : narrow_feasible) {
+    t << Where(logs, n.log, n.frame) << " narrow bay " << n.bay_id << " at (" << n.x_m << ", " << n.y_m << ") m, "
+      << n.bay_width_m << " m wide, reported feasible: a slot " << n.slot_length_m << " m long between tracks "
+      << n.prev_id << " and " << n.next_id << ", confidence " << n.confidence << "\n";
   }
   return t.str();
 }

@@ -78,6 +78,18 @@ struct SceneSlotMiss {
   std::string slot_reason;      ///< why it was reported infeasible
 };
 
+/// A frame where a bay too narrow for the ego was reported feasible: the slot reported there.
+struct SceneNarrowFeasible {
+  int log = 0;
+  std::int64_t frame = 0;
+  int bay_id = -1;
+  double x_m = 0.0, y_m = 0.0;  ///< bay centre, vehicle frame
+  double bay_width_m = 0.0;     ///< the bay's true width along the row
+  double slot_length_m = 0.0;   ///< the free length the slot was reported with
+  int prev_id = -1, next_id = -1;  ///< the neighbours' track ids it was bounded by
+  double confidence = 0.0;
+};
+
 struct SceneEval {
   std::int64_t frames = 0;
   std::int64_t logs = 0;  ///< runs pooled (counts summed, medians over all matches)
@@ -101,12 +113,14 @@ struct SceneEval {
   std::vector<SceneMiss> misses;  ///< visible truths missed (only when visibility_scored)
   std::vector<SceneFalseAlarm> false_alarms;  ///< unmatched detections (only when visibility_scored)
   std::vector<SceneSlotMiss> slot_misses;  ///< visible feasible bays not found
+  std::vector<SceneNarrowFeasible> narrow_feasible;  ///< one per narrow_reported_feasible
   /// {"frames":N, "car":{...}, ...} exactly as the issue specifies.
   std::string ToJson() const;
   std::string ToText() const;
   /// One line per miss (frame, class, where, visibility, the nearest detection), then one per
   /// false alarm (where, size, the nearest truth), then one per visible feasible bay not found
-  /// (where, the nearest slot reported and why it was infeasible).
+  /// (where, the nearest slot reported and why it was infeasible), then one per narrow bay
+  /// reported feasible (where, the slot's length and the neighbours that bounded it).
   std::string MissesText() const;
 };
 
