@@ -301,15 +301,18 @@ void Scorer::Add(const std::string& log_path, int log_index) {
             found = &s;
           }
         }
+        auto at_bay = [&](SceneBayAt* at) {
+          at->log = log_index;
+          at->frame = frame_index;
+          at->bay_id = bay.id;
+          at->x_m = bay_v.x();
+          at->y_m = bay_v.y();
+        };
         if (!bay.feasible) {
           if (found != nullptr && found->feasible) {
             ++out_.narrow_reported_feasible;
             SceneNarrowFeasible narrow;
-            narrow.log = log_index;
-            narrow.frame = frame_index;
-            narrow.bay_id = bay.id;
-            narrow.x_m = bay_v.x();
-            narrow.y_m = bay_v.y();
+            at_bay(&narrow);
             narrow.bay_width_m = bay.width_m;
             narrow.slot_length_m = found->length_m;
             narrow.prev_id = found->prev_id;
@@ -327,11 +330,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
           slot_yaw_.push_back(AxisAngleDeg(found->target.yaw_rad, bay.yaw_rad));
         } else {
           SceneSlotMiss miss;
-          miss.log = log_index;
-          miss.frame = frame_index;
-          miss.bay_id = bay.id;
-          miss.x_m = bay_v.x();
-          miss.y_m = bay_v.y();
+          at_bay(&miss);
           miss.slot_near = found != nullptr;
           miss.slot_m = found != nullptr ? best : 0.0;
           miss.slot_reason = found != nullptr ? found->reason : "";

@@ -66,24 +66,24 @@ struct SceneFalseAlarm {
   std::string inside_truth_class;
 };
 
-/// A feasible bay fully visible in a frame where no feasible slot was reported at it: what was
-/// reported nearest to it instead.
-struct SceneSlotMiss {
+/// A bay in one frame of one run.
+struct SceneBayAt {
   int log = 0;
   std::int64_t frame = 0;
   int bay_id = -1;
   double x_m = 0.0, y_m = 0.0;  ///< bay centre, vehicle frame
+};
+
+/// A feasible bay fully visible in a frame where no feasible slot was reported at it: what was
+/// reported nearest to it instead.
+struct SceneSlotMiss : SceneBayAt {
   bool slot_near = false;       ///< a slot was reported within SceneEvalParams::slot_match_m
   double slot_m = 0.0;          ///< its target's distance from the bay centre
   std::string slot_reason;      ///< why it was reported infeasible
 };
 
 /// A frame where a bay too narrow for the ego was reported feasible: the slot reported there.
-struct SceneNarrowFeasible {
-  int log = 0;
-  std::int64_t frame = 0;
-  int bay_id = -1;
-  double x_m = 0.0, y_m = 0.0;  ///< bay centre, vehicle frame
+struct SceneNarrowFeasible : SceneBayAt {
   double bay_width_m = 0.0;     ///< the bay's true width along the row
   double slot_length_m = 0.0;   ///< the free length the slot was reported with
   int prev_id = -1, next_id = -1;  ///< the neighbours' track ids it was bounded by
