@@ -940,7 +940,6 @@ TEST(PipelineTest, MissesListEachFrameTheNarrowBayWasReportedFeasible) {
   n.next_id = 57;
   n.confidence = 0.95;
   e.narrow_feasible.push_back(n);
-  e.narrow_reported_feasible = 1;
   EXPECT_NE(e.MissesText().find("frame 34 narrow bay 2 at (7.63, 2.71) m, 1.89 m wide, reported feasible: a slot "
                                 "3.49 m long between tracks 5 and 57, confidence 0.95\n"),
             std::string::npos)

@@ -310,7 +310,6 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         };
         if (!bay.feasible) {
           if (found != nullptr && found->feasible) {
-            ++out_.narrow_reported_feasible;
             SceneNarrowFeasible narrow;
             at_bay(&narrow);
             narrow.bay_width_m = bay.width_m;
@@ -426,7 +425,7 @@ std::string SceneEval::ToJson() const {
      << ", \"car_yaw_err_deg_median\":" << car_yaw_err_deg_median << ", \"id_switches\":" << id_switches << ", \"prediction\":{\"ade\":" << ade_m << ", \"fde\":" << fde_m
      << "}, \"slot\":{\"visible_frames\":" << slot_visible_frames << ", \"found_frames\":" << slot_found_frames
      << ", \"center_err_m\":" << slot_center_err_m << ", \"yaw_err_deg\":" << slot_yaw_err_deg
-     << ", \"narrow_reported_feasible\":" << narrow_reported_feasible << "}";
+     << ", \"narrow_reported_feasible\":" << narrow_reported_feasible() << "}";
   if (visibility_scored) {
     js << ", \"car_visible\":" << ClassJson(car_visible, false)
        << ", \"pedestrian_visible\":" << ClassJson(pedestrian_visible, false)
@@ -461,7 +460,7 @@ std::string SceneEval::ToText() const {
     << " predictions scored)\n"
     << "parking slot: found in " << slot_found_frames << "/" << slot_visible_frames
     << " frames where visible, centre error " << slot_center_err_m << " m, yaw error " << slot_yaw_err_deg
-    << " deg; narrow bay reported feasible " << narrow_reported_feasible << " times\n";
+    << " deg; narrow bay reported feasible " << narrow_reported_feasible() << " times\n";
   return t.str();
 }
 

@@ -109,11 +109,11 @@ struct SceneEval {
   std::int64_t slot_visible_frames = 0, slot_found_frames = 0;
   double slot_center_err_m = 0.0;  ///< median over found frames
   double slot_yaw_err_deg = 0.0;   ///< median over found frames
-  std::int64_t narrow_reported_feasible = 0;
   std::vector<SceneMiss> misses;  ///< visible truths missed (only when visibility_scored)
   std::vector<SceneFalseAlarm> false_alarms;  ///< unmatched detections (only when visibility_scored)
   std::vector<SceneSlotMiss> slot_misses;  ///< visible feasible bays not found
-  std::vector<SceneNarrowFeasible> narrow_feasible;  ///< one per narrow_reported_feasible
+  std::vector<SceneNarrowFeasible> narrow_feasible;  ///< each frame the narrow bay was reported feasible
+  std::int64_t narrow_reported_feasible() const { return static_cast<std::int64_t>(narrow_feasible.size()); }
   /// {"frames":N, "car":{...}, ...} exactly as the issue specifies.
   std::string ToJson() const;
   std::string ToText() const;
