@@ -152,10 +152,11 @@ void Run(const Options& o) {
     std::fputs(js.str().c_str(), stdout);
     return;
   }
-  std::printf("%s: %zu points, ground plane (%.4f, %.4f, %.4f, %.4f) %s, %d inliers, %zu ground points removed\n",
+  std::printf("%s: %zu points, ground plane (%.4f, %.4f, %.4f, %.4f) %s, %d inliers, %zu ground points removed "
+              "(%zu more too far below it to be ground)\n",
               o.pcd.c_str(), cloud.size(), plane[0], plane[1], plane[2], plane[3],
               ground.refined ? "fitted" : "prior (not enough ground to fit)", ground.ransac_inliers,
-              ground.ground.size());
+              ground.ground.size(), ground.below.size());
   std::printf("%zu blobs at %.3f m leaves (%zu occupied leaves, %zu small dropped, %zu refined)\n", blobs.size(),
               o.leaf_m, s.occupied_leaves, s.dropped_small, s.refined);
   for (std::size_t b = 0; b < blobs.size(); ++b) {

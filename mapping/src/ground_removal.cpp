@@ -1,5 +1,6 @@
 #include "romo/mapping/ground_removal.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -27,6 +28,8 @@ void GroundRemovalParams::Validate() const {
   if (!(std::isfinite(search_band_m) && search_band_m > 0.f)) fail("search_band_m", search_band_m, "must be finite and > 0");
   if (!(std::isfinite(height_tolerance_m) && height_tolerance_m >= 0.f))
     fail("height_tolerance_m", height_tolerance_m, "must be finite and >= 0");
+  if (!(below_tolerance_m >= 0.f)) fail("below_tolerance_m", below_tolerance_m, "must be >= 0 (or infinite)");
+  if (!(std::isfinite(below_sigmas) && below_sigmas >= 0.f)) fail("below_sigmas", below_sigmas, "must be finite and >= 0");
   if (min_inliers < 3) fail("min_inliers", min_inliers, "must be >= 3");
   ransac.Validate();
 }
@@ -56,8 +59,11 @@ GroundRemoval RemoveGround(const PointCloud& cloud, const GroundRemovalParams& p
   out.ground.reserve(candidates.size());
   out.obstacles.reserve(finite.indices.size() - candidates.size() / 2);
   for (int i : finite.indices) {
-    // On or below the plane plus tolerance: ground (including reflections/noise under it).
-    if (out.plane.SignedDistance(cloud.xyz.col(i)) <= params.height_tolerance_m) {
+    // On or below the plane plus tolerance: ground (including noise under it), unless too deep.
+    const float height = out.plane.SignedDistance(cloud.xyz.col(i));
+    if (height < -std::max(params.below_tolerance_m, params.below_sigmas * cloud.sigma_z_m[i])) {
+      out.below.push_back(i);
+    } else if (height <= params.height_tolerance_m) {
       out.ground.push_back(i);
     } else {
       out.obstacles.push_back(i);

@@ -1,4 +1,6 @@
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -78,6 +80,38 @@ TEST(GroundRemovalTest, WithoutGroundPointsThePriorIsUsedAndReported) {
   EXPECT_TRUE(RemoveGround(PointCloud{}, params).obstacles.empty());
   params.height_tolerance_m = -1.f;
   EXPECT_THROW(RemoveGround(scene.cloud, params), romo::Error);
+}
+
+// Stereo mismatches land far under the ground (0.2-3 m under it in the simulated parking scene):
+// removed, but not counted as ground, whose presence says a place is free. Noise under it within
+// the tolerance, or within each point's depth sigma when that is larger, stays ground.
+TEST(GroundRemovalTest, PointsFarBelowThePlaneAreNotGround) {
+  PointCloud cloud;
+  for (int x = 0; x < 20; ++x) {
+    for (int y = 0; y < 20; ++y) cloud.PushBack(Eigen::Vector3f(0.25f * x, 0.25f * y, 0.f), 0.02f);
+  }
+  const int first_extra = static_cast<int>(cloud.size());
+  cloud.PushBack(Eigen::Vector3f(1.f, 1.f, -0.08f), 0.02f);  // within the 0.1 m tolerance
+  cloud.PushBack(Eigen::Vector3f(1.f, 2.f, -0.3f), 0.5f);    // far and uncertain: within 1 sigma
+  cloud.PushBack(Eigen::Vector3f(2.f, 1.f, -0.3f), 0.12f);   // 0.3 m under with a 0.12 m sigma
+  cloud.PushBack(Eigen::Vector3f(2.f, 2.f, -2.9f), 0.18f);
+  cloud.PushBack(Eigen::Vector3f(3.f, 3.f, 1.0f), 0.02f);    // an obstacle
+
+  GroundRemovalParams params;
+  const GroundRemoval g = RemoveGround(cloud, params);
+  ASSERT_TRUE(g.refined);
+  EXPECT_EQ(g.below, (std::vector<int>{first_extra + 2, first_extra + 3}));
+  EXPECT_EQ(g.obstacles, (std::vector<int>{first_extra + 4}));
+  EXPECT_EQ(g.ground.size(), static_cast<std::size_t>(first_extra + 2));
+  EXPECT_EQ(g.ground.back(), first_extra + 1);
+
+  params.below_tolerance_m = std::numeric_limits<float>::infinity();  // everything under is ground
+  const GroundRemoval all = RemoveGround(cloud, params);
+  EXPECT_TRUE(all.below.empty());
+  EXPECT_EQ(all.ground.size(), static_cast<std::size_t>(first_extra + 4));
+
+  params.below_sigmas = -1.f;
+  EXPECT_THROW(RemoveGround(cloud, params), romo::Error);
 }
 
 }  // namespace

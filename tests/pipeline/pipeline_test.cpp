@@ -519,6 +519,70 @@ TEST(PipelineTest, APersonWhoseLegsGoOutOfSightStaysAPedestrianBoxedFromTheGroun
   EXPECT_EQ(never_whole->class_name, "unknown");
 }
 
+// The front rig's cloud: ground all round with a row's painted front line 8 m ahead (0.12 m
+// wide, across the vehicle's heading, grey 250 on asphalt 100), a car's front 0.8 m wide seen
+// 0.3 m behind the line (its neighbours hide the rest; the ground behind it is unseen), and a
+// person standing on the line 3 m to the left.
+RigInput CarFaceAtARowsFront(bool painted) {
+  RigInput in = SyntheticRig(1, 1000);  // ground only
+  in.rig_id = 0;
+  DropPoints(&in.cloud, [](const Eigen::Vector3f& p) {
+    return p.x() >= 8.2f && p.x() <= 13.f && p.y() >= -5.2f && p.y() <= -3.0f;
+  });
+  if (painted) {
+    for (float y = -10.f; y <= 10.f; y += 0.05f) {
+      for (float x = 7.96f; x <= 8.041f; x += 0.04f) in.cloud.PushBack({x, y, 0.f}, 0.01f, 250.f);
+    }
+  }
+  for (float x : {8.3f, 8.4f}) {
+    for (float y = -4.5f; y <= -3.7f; y += 0.03f) {
+      for (float z = 0.05f; z <= 1.3f; z += 0.03f) in.cloud.PushBack({x, y, z}, 0.01f, 50.f);
+    }
+  }
+  AddColumn(&in.cloud, {8.3f, 3.0f}, 1.7f);
+  return in;
+}
+
+TEST(PipelineTest, ACarsFrontAtARowsPaintedFrontIsACarAlongTheBays) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto near = [](const FrameResult& r, const Eigen::Vector2d& xy, double within) {
+    std::optional<planning_iface::Obstacle> found;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.num_points > 0 && (o.center_m.head<2>() - xy).norm() < within) found = o;
+    }
+    return found;
+  };
+  const FrameResult painted =
+      Pipeline(calibration, PipelineParams{}).ProcessClouds(1000, 1, {CarFaceAtARowsFront(true)}, std::nullopt, std::nullopt);
+  // The face's middle (y -4.1) and 0.3 m behind the line plus half the Atlas car's mean length
+  // (4.4 m): x 10.5. Tolerance: the points' spacing (0.03 m) and the line's fit (0.05 m).
+  const auto car = near(painted, {10.5, -4.1}, 1.0);
+  ASSERT_TRUE(car.has_value());
+  EXPECT_EQ(car->class_name, "car");
+  EXPECT_NEAR(car->center_m.x(), 10.5, 0.1);
+  EXPECT_NEAR(car->center_m.y(), -4.1, 0.1);
+  EXPECT_NEAR(std::abs(std::sin(car->yaw_rad)), 0.0, std::sin(1.0 * 3.14159265 / 180.0)) << "along the bays";
+  EXPECT_NEAR(car->size_m.x(), 4.4, 1e-3);
+  // A person on the line is narrower than any car's face: still a person.
+  const auto person = near(painted, {8.3, 3.0}, 0.3);
+  ASSERT_TRUE(person.has_value());
+  EXPECT_EQ(person->class_name, "pedestrian");
+
+  // Without the paint, or with bays_from_paint off, the face is a piece of no class.
+  const FrameResult bare =
+      Pipeline(calibration, PipelineParams{}).ProcessClouds(1000, 1, {CarFaceAtARowsFront(false)}, std::nullopt, std::nullopt);
+  const auto piece = near(bare, {8.35, -4.1}, 0.3);
+  ASSERT_TRUE(piece.has_value());
+  EXPECT_EQ(piece->class_name, "unknown");
+  PipelineParams off;
+  off.bays_from_paint = false;
+  const FrameResult unused =
+      Pipeline(calibration, off).ProcessClouds(1000, 1, {CarFaceAtARowsFront(true)}, std::nullopt, std::nullopt);
+  const auto piece_again = near(unused, {8.35, -4.1}, 0.3);
+  ASSERT_TRUE(piece_again.has_value());
+  EXPECT_EQ(piece_again->class_name, "unknown");
+}
+
 TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   auto pedestrians = [](const FrameResult& r) {
@@ -827,6 +891,11 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   rejects(params.parked_speed_per_depth_spread, {-0.25, std::nan("")});
   rejects(params.parked_pieces_margin_m, {-0.5, std::nan("")});
   rejects(params.parked_pieces_walked_m, {std::nan("")});
+  rejects(params.bay_front_m, {-0.1, std::nan("")});
+  rejects(params.bay_snap_max_width_m, {1.0, INFINITY});
+  rejects(params.bay_face_min_spread_m, {-0.6});
+  rejects(params.bay_face_score, {0.0, 1.5});
+  rejects(params.bay_row.contrast, {1.0});
   EXPECT_NO_THROW(params.Validate());
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);

@@ -15,6 +15,7 @@
 
 #include "romo/core/angles.hpp"
 #include "romo/core/check.hpp"
+#include "romo/core/statistics.hpp"
 #include "romo/objects/atlas.hpp"
 #include "romo/objects/geo.hpp"
 #include "romo/objects/view_completion.hpp"
@@ -38,6 +39,14 @@ constexpr float kCos45 = 0.7071f;
 double YawOf(const Eigen::Isometry3d& T) {
   const Eigen::Vector3d x = T.rotation().col(0);
   return std::atan2(x.y(), x.x());
+}
+
+// Turns @p box to @p yaw_rad about @p up (its length axis along the heading, level with the ground).
+void SetYaw(objects::Box3* box, float yaw_rad, const Eigen::Vector3f& up) {
+  box->yaw_rad = yaw_rad;
+  const Eigen::Vector3f heading(std::cos(yaw_rad), std::sin(yaw_rad), 0.0f);
+  box->axes.col(0) = (heading - up * up.dot(heading)).normalized();
+  box->axes.col(1) = up.cross(box->axes.col(0));
 }
 
 Eigen::Vector2d Rotate(const Eigen::Vector2d& v, double yaw) {
@@ -316,8 +325,32 @@ void PipelineParams::Validate() const {
   tracker.Validate();
   parking.Validate();
   bay_edges.Validate();
+  bay_row.Validate();
   if (!(bay_strip_margin_m >= 0)) {
     Fail("pipeline: bay_strip_margin_m must be >= 0, got " + std::to_string(bay_strip_margin_m));
+  }
+  const std::pair<const char*, double> bay_lengths[] = {
+      {"bay_front_m", bay_front_m},
+      {"bay_face_depth_m", bay_face_depth_m},
+      {"bay_snap_min_width_m", bay_snap_min_width_m},
+      {"bay_snap_min_offset_m", bay_snap_min_offset_m},
+      {"bay_snap_min_off_deg", bay_snap_min_off_deg},
+      {"bay_snap_max_face_m", bay_snap_max_face_m},
+      {"bay_snap_ground_ratio", bay_snap_ground_ratio},
+      {"bay_face_front_tolerance_m", bay_face_front_tolerance_m},
+      {"bay_face_min_spread_m", bay_face_min_spread_m},
+      {"bay_face_width_slack_m", bay_face_width_slack_m},
+      {"bay_face_min_range_m", bay_face_min_range_m},
+      {"bay_face_max_ground_ratio", bay_face_max_ground_ratio}};
+  for (const auto& [name, value] : bay_lengths) {
+    if (!(std::isfinite(value) && value >= 0)) Fail(std::string("pipeline: ") + name + " must be finite and >= 0, got " + std::to_string(value));
+  }
+  if (!(bay_snap_max_width_m >= bay_snap_min_width_m && std::isfinite(bay_snap_max_width_m))) {
+    Fail("pipeline: bay_snap_max_width_m must be finite and >= bay_snap_min_width_m (" +
+         std::to_string(bay_snap_min_width_m) + "), got " + std::to_string(bay_snap_max_width_m));
+  }
+  if (!(bay_face_score > 0 && bay_face_score <= 1)) {
+    Fail("pipeline: bay_face_score must be in (0, 1], got " + std::to_string(bay_face_score));
   }
 }
 
@@ -369,6 +402,14 @@ class Pipeline::Impl {
         continue;
       }
       if (!steady && parked_from_steady_view.count(tr.id) > 0) continue;
+      // A track seen far from where it was remembered has jumped to another car (coasting tracks
+      // take the blobs of cars they pass): the car remembered stays, and this one is not
+      // remembered under that track.
+      const auto remembered = parked.find(tr.id);
+      if (remembered != parked.end() &&
+          (remembered->second.xy_m - car.xy_m).norm() >= 0.5 * std::max(remembered->second.length_m, car.length_m)) {
+        continue;
+      }
       // The same car remembered under an earlier track (an ID switch, or a replay looping back)
       // is replaced, not listed twice.
       for (auto it = parked.begin(); it != parked.end();) {
@@ -413,10 +454,11 @@ class Pipeline::Impl {
         it = ForgetParkedCar(it);
         continue;
       }
+      // (by place, not track id: a track that jumped to another car does not show this one)
       bool seen_now = false;
       for (const auto& o : r.obstacles.obstacles) {
         seen_now = seen_now || (o.class_name == car_name && o.num_points > 0 &&
-                                (o.track_id == it->first || (o.center_m.head<2>() - xy).norm() < 0.5 * d.length_m));
+                                (o.center_m.head<2>() - xy).norm() < 0.5 * d.length_m);
       }
       if (!seen_now) hidden.emplace_back(*it);
       ++it;
@@ -451,11 +493,7 @@ class Pipeline::Impl {
         const float yaw = static_cast<float>(car.yaw_rad - r.ego_world.yaw_rad);
         box.center.head<2>() = xy.cast<float>();
         box.size = Eigen::Vector3f(static_cast<float>(car.length_m), static_cast<float>(car.width_m), box.size.z());
-        box.yaw_rad = yaw;
-        const Eigen::Vector3f up = box.axes.col(2);
-        const Eigen::Vector3f heading(std::cos(yaw), std::sin(yaw), 0.0f);
-        box.axes.col(0) = (heading - up * up.dot(heading)).normalized();
-        box.axes.col(1) = up.cross(box.axes.col(0));
+        SetYaw(&box, yaw, box.axes.col(2));
         const objects::Classification cls = d.classification;
         d = car;
         d.classification = cls;
@@ -796,6 +834,184 @@ class Pipeline::Impl {
     }
   }
 
+  // Cars placed by the paint of the row they stand in (PipelineParams::bays_from_paint).
+  void PlaceCarsInRow(FrameResult& r, const Eigen::Vector3f& up, std::vector<Seen>* seen) const {
+    if (!params.bays_from_paint || car_class < 0) return;
+    const std::optional<mapping::BayRow> row = mapping::FindBayRow(r.cloud, r.ground_indices, params.bay_row);
+    if (!row) return;
+    SnapCarsToBays(r, up, *row, seen);
+    CompleteFacesInRow(r, up, *row, seen);
+  }
+
+  // A blob's points as (along the row, depth into the bays).
+  static std::vector<Eigen::Vector2d> RowPoints(const FrameResult& r, const std::vector<int>& blob,
+                                                const mapping::BayRow& row) {
+    std::vector<Eigen::Vector2d> out;
+    out.reserve(blob.size());
+    for (int p : blob) {
+      const Eigen::Vector2d xy = r.cloud.xyz.col(p).head<2>().cast<double>();
+      out.emplace_back(row.Along(xy), row.Depth(xy));
+    }
+    return out;
+  }
+
+  // Where a blob's face toward the aisle is: its front (10th percentile depth) and its span along
+  // the row (5th to 95th percentile) over the points within bay_face_depth_m behind that front.
+  struct RowFace {
+    double front_m = 0.0;
+    double lo_m = 0.0;
+    double hi_m = 0.0;
+  };
+  RowFace FaceOf(const std::vector<Eigen::Vector2d>& points) const {
+    std::vector<double> depths, alongs;
+    for (const Eigen::Vector2d& q : points) depths.push_back(q.y());
+    RowFace face;
+    face.front_m = Percentile(depths, 0.1);
+    for (const Eigen::Vector2d& q : points) {
+      if (q.y() <= face.front_m + params.bay_face_depth_m) alongs.push_back(q.x());
+    }
+    face.lo_m = Percentile(alongs, 0.05);
+    face.hi_m = Percentile(alongs, 0.95);
+    return face;
+  }
+
+  // @p box moved to @p xy (vehicle frame), its footprint @p length_m x @p width_m, turned to
+  // @p yaw_rad about @p up.
+  static void PlaceBox(objects::Box3* box, const Eigen::Vector2d& xy, double yaw_rad, double length_m,
+                       double width_m, const Eigen::Vector3f& up) {
+    box->center.head<2>() = xy.cast<float>();
+    box->size.head<2>() = Eigen::Vector2f(static_cast<float>(length_m), static_cast<float>(width_m));
+    SetYaw(box, static_cast<float>(yaw_rad), up);
+  }
+
+  // Car boxes whose front part lies in one bay between two separators, but off its centre line or
+  // its heading, are moved onto it; car boxes off the bays' heading where no bay is seen are turned
+  // to it and centred on their face (PipelineParams::bay_snap_*).
+  void SnapCarsToBays(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
+                      std::vector<Seen>* seen) const {
+    const std::vector<double>& seps = row.separators_m;
+    const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
+    const double bay_heading = std::atan2(row.into_bays.y(), row.into_bays.x());
+    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+      Seen& v = (*seen)[i];
+      if (!v.on_ground || v.framed || v.viewed.classification.class_index != car_class) continue;
+      objects::Box3& box = v.viewed.box;
+      const Eigen::Vector2d centre = box.center.head<2>().cast<double>();
+      const double centre_depth = row.Depth(centre);
+      if (centre_depth < 0.0 || centre_depth > car.length.max_m) continue;  // not in this row
+      const std::vector<Eigen::Vector2d> points = RowPoints(r, r.blobs[i], row);
+      std::vector<Eigen::Vector2d> front;
+      for (const Eigen::Vector2d& q : points) {
+        if (q.y() <= params.bay_front_m) front.push_back(q);
+      }
+      const std::vector<Eigen::Vector2d>& deciding = front.empty() ? points : front;
+      std::size_t best_bay = seps.size();
+      std::ptrdiff_t best_count = 0;
+      for (std::size_t k = 0; k + 1 < seps.size(); ++k) {
+        const double bay_width = seps[k + 1] - seps[k];
+        if (bay_width < params.bay_snap_min_width_m || bay_width > params.bay_snap_max_width_m) continue;
+        const auto count = std::count_if(deciding.begin(), deciding.end(), [&](const Eigen::Vector2d& q) {
+          return q.x() >= seps[k] && q.x() < seps[k + 1];
+        });
+        if (count > best_count) {
+          best_count = count;
+          best_bay = k;
+        }
+      }
+      const bool off_heading = AxisAngle(box.yaw_rad, bay_heading) > params.bay_snap_min_off_deg * kPi / 180.0;
+      const double length = std::max(box.size.x(), box.size.y());
+      double width = std::min(box.size.x(), box.size.y());
+      double lateral = 0.0;
+      // Seen far off, the face is smeared along the sight line, and the box with it; the face's far
+      // end is never hidden, its near end rarely: its middle is the car's. In a bay, it is kept
+      // within the bay's lines: a bay beside a free one is wider than its car on that side, so its
+      // centre line is no car's.
+      const RowFace face = FaceOf(points);
+      lateral = 0.5 * (face.lo_m + face.hi_m);
+      if (best_bay < seps.size() && 2 * best_count > static_cast<std::ptrdiff_t>(deciding.size())) {
+        const double lo = seps[best_bay], hi = seps[best_bay + 1];
+        width = std::min(width, hi - lo);
+        lateral = std::clamp(lateral, lo + 0.5 * width, hi - 0.5 * width);
+        if (std::abs(row.Along(centre) - lateral) <= params.bay_snap_min_offset_m && !off_heading) continue;
+      } else {
+        if (!off_heading || face.hi_m - face.lo_m > params.bay_snap_max_face_m) continue;  // (several cars' faces)
+        width = std::min(width, car.width.mean_m);
+      }
+      std::vector<double> depths;
+      for (const Eigen::Vector2d& q : points) {
+        if (std::abs(q.x() - lateral) <= 0.5 * width) depths.push_back(q.y());
+      }
+      if (depths.empty()) continue;
+      const double yaw = std::remainder(
+          std::cos(box.yaw_rad - bay_heading) >= 0.0 ? bay_heading : bay_heading + kPi, 2.0 * kPi);
+      const double front_depth = std::max(0.0, Percentile(depths, 0.1));
+      const Eigen::Vector2d xy = row.origin + lateral * row.along + (front_depth + 0.5 * length) * row.into_bays;
+      // Far off, stereo smears ground into any car's footprint: only more of it than the box as
+      // seen held says the place is free.
+      const int ground = GroundPointsInside(r, xy, yaw, length, width, params.row_align_free_ground_margin_m);
+      if (ground >= params.row_align_free_ground_points &&
+          ground > params.bay_snap_ground_ratio *
+                       GroundPointsInside(r, centre, box.yaw_rad, box.size.x(), box.size.y(),
+                                          params.row_align_free_ground_margin_m)) {
+        continue;
+      }
+      PlaceBox(&box, xy, yaw, length, width, up);
+    }
+  }
+
+  // Pieces of no class on the ground at the row's front, a car's face wide (wider than a person),
+  // at least bay_face_min_range_m away and clear of the cars, are cars seen end-on between their
+  // neighbours; pieces read as a person the same where no walker stood (WalkerNear). Boxed along
+  // the bays from the face, of the Atlas car's mean size (PipelineParams::bay_face_*).
+  void CompleteFacesInRow(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
+                          std::vector<Seen>* seen) const {
+    const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
+    const double bay_heading = std::atan2(row.into_bays.y(), row.into_bays.x());
+    const double length = car.length.mean_m, width = car.width.mean_m;
+    std::vector<Eigen::Vector2d> car_centres;
+    for (const Seen& v : *seen) {
+      if (v.viewed.classification.class_index == car_class) {
+        car_centres.push_back(v.viewed.box.center.head<2>().cast<double>());
+      }
+    }
+    for (std::size_t i = 0; i < r.boxes.size(); ++i) {
+      Seen& v = (*seen)[i];
+      const int cls = v.viewed.classification.class_index;
+      if (!v.on_ground || (cls != atlas.unknown_index() && (cls != pedestrian_class || pedestrian_class < 0))) {
+        continue;
+      }
+      if (cls == pedestrian_class) {
+        const Eigen::Vector3f c = v.viewed.box.center;
+        if (WalkerNear((r.T_world_vehicle * Eigen::Vector3d(c.x(), c.y(), 0.0)).head<2>())) continue;
+      }
+      const RowFace face = FaceOf(RowPoints(r, r.blobs[i], row));
+      const double spread = face.hi_m - face.lo_m;
+      if (face.front_m < -params.bay_face_front_tolerance_m || face.front_m > params.bay_front_m ||
+          spread < params.bay_face_min_spread_m || spread > car.width.max_m + params.bay_face_width_slack_m) {
+        continue;
+      }
+      const double lateral = 0.5 * (face.lo_m + face.hi_m);
+      const Eigen::Vector2d xy =
+          row.origin + lateral * row.along + (std::max(0.0, face.front_m) + 0.5 * length) * row.into_bays;
+      if (xy.norm() < params.bay_face_min_range_m ||
+          std::any_of(car_centres.begin(), car_centres.end(), [&](const Eigen::Vector2d& c) {
+            return std::abs(row.Along(c) - lateral) < width && std::abs(row.into_bays.dot(c - xy)) < length;
+          }) ||
+          GroundPointsInside(r, xy, bay_heading, length, width, params.row_align_free_ground_margin_m) >
+              params.bay_face_max_ground_ratio * static_cast<double>(r.blobs[i].size())) {
+        continue;
+      }
+      objects::Box3 box = v.viewed.box;
+      const float bottom = box.center.z() - 0.5f * box.size.z();
+      box.size.z() = static_cast<float>(car.height.mean_m);
+      box.center.z() = bottom + 0.5f * box.size.z();
+      PlaceBox(&box, xy, bay_heading, length, width, up);
+      v.viewed.box = box;
+      v.viewed.classification = {car_class, params.bay_face_score};
+      car_centres.push_back(xy);
+    }
+  }
+
   // Splits long blobs seen across their length at a gap when both parts are cars
   // (PipelineParams::face_pair_*): the ends of two neighbouring parked cars.
   void SplitFacePairs(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
@@ -1099,6 +1315,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   s.SplitTandems(r, up, &viewers, &seen);
   s.UnclassifyFramedFaces(r, viewers, &seen);
   s.AlignCarsToRow(r, up, viewers, &seen);
+  s.PlaceCarsInRow(r, up, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {
