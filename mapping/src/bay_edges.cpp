@@ -31,30 +31,20 @@ std::vector<double> PositionsIn(const std::vector<Sample>& samples, double origi
 }  // namespace
 
 void BayEdgeParams::Validate() const {
-  const auto fail = [](const char* field, double value, const char* rule) {
-    std::ostringstream msg;
-    msg << "BayEdgeParams." << field << " = " << value << ": " << rule;
-    Fail(msg.str());
-  };
-  const auto positive = [&](const char* field, double v) {
-    if (!(std::isfinite(v) && v > 0)) fail(field, v, "must be finite and > 0");
-  };
-  const auto non_negative = [&](const char* field, double v) {
-    if (!(std::isfinite(v) && v >= 0)) fail(field, v, "must be finite and >= 0");
-  };
-  positive("bin_m", bin_m);
-  if (min_bin_points < 1) fail("min_bin_points", min_bin_points, "must be >= 1");
-  if (min_reference_points < 1) fail("min_reference_points", min_reference_points, "must be >= 1");
-  if (!(std::isfinite(paint_contrast) && paint_contrast > 1)) fail("paint_contrast", paint_contrast, "must be > 1");
-  positive("max_paint_width_m", max_paint_width_m);
-  non_negative("front_search_m", front_search_m);
-  non_negative("front_behind_m", front_behind_m);
+  const FieldCheck check("BayEdgeParams");
+  check.Positive("bin_m", bin_m);
+  if (min_bin_points < 1) check.Fail("min_bin_points", min_bin_points, "must be >= 1");
+  if (min_reference_points < 1) check.Fail("min_reference_points", min_reference_points, "must be >= 1");
+  if (!(std::isfinite(paint_contrast) && paint_contrast > 1)) check.Fail("paint_contrast", paint_contrast, "must be > 1");
+  check.Positive("max_paint_width_m", max_paint_width_m);
+  check.NonNegative("front_search_m", front_search_m);
+  check.NonNegative("front_behind_m", front_behind_m);
   if (!(std::isfinite(surface_contrast) && surface_contrast > 1)) {
-    fail("surface_contrast", surface_contrast, "must be > 1");
+    check.Fail("surface_contrast", surface_contrast, "must be > 1");
   }
-  if (surface_min_bins < 1) fail("surface_min_bins", surface_min_bins, "must be >= 1");
-  non_negative("rear_search_before_m", rear_search_before_m);
-  non_negative("rear_search_after_m", rear_search_after_m);
+  if (surface_min_bins < 1) check.Fail("surface_min_bins", surface_min_bins, "must be >= 1");
+  check.NonNegative("rear_search_before_m", rear_search_before_m);
+  check.NonNegative("rear_search_after_m", rear_search_after_m);
 }
 
 BayEdges FindBayEdges(const PointCloud& cloud, const std::vector<int>& ground,

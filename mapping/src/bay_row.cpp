@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <sstream>
 
 #include <Eigen/Eigenvalues>
 
@@ -88,38 +87,25 @@ std::vector<double> SeparatorsIn(const std::vector<Eigen::Vector2d>& band, const
 }  // namespace
 
 void BayRowParams::Validate() const {
-  const auto fail = [](const char* field, double value, const char* rule) {
-    std::ostringstream msg;
-    msg << "BayRowParams." << field << " = " << value << ": " << rule;
-    Fail(msg.str());
-  };
-  const auto positive = [&](const char* field, double v) {
-    if (!(std::isfinite(v) && v > 0)) fail(field, v, "must be finite and > 0");
-  };
-  positive("max_range_m", max_range_m);
-  if (!(std::isfinite(contrast) && contrast > 1)) fail("contrast", contrast, "must be > 1");
-  positive("line_half_width_m", line_half_width_m);
-  positive("line_bin_m", line_bin_m);
-  positive("min_covered_m", min_covered_m);
-  if (hypotheses < 1) fail("hypotheses", hypotheses, "must be >= 1");
-  positive("min_pair_distance_m", min_pair_distance_m);
-  if (min_paint_points < 2) fail("min_paint_points", min_paint_points, "must be >= 2");
-  if (!(std::isfinite(separator_from_m) && separator_from_m >= 0)) {
-    fail("separator_from_m", separator_from_m, "must be finite and >= 0");
-  }
+  const FieldCheck check("BayRowParams");
+  check.Positive("max_range_m", max_range_m);
+  if (!(std::isfinite(contrast) && contrast > 1)) check.Fail("contrast", contrast, "must be > 1");
+  check.Positive("line_half_width_m", line_half_width_m);
+  check.Positive("line_bin_m", line_bin_m);
+  check.Positive("min_covered_m", min_covered_m);
+  if (hypotheses < 1) check.Fail("hypotheses", hypotheses, "must be >= 1");
+  check.Positive("min_pair_distance_m", min_pair_distance_m);
+  if (min_paint_points < 2) check.Fail("min_paint_points", min_paint_points, "must be >= 2");
+  check.NonNegative("separator_from_m", separator_from_m);
   if (!(std::isfinite(separator_to_m) && separator_to_m > separator_from_m)) {
-    fail("separator_to_m", separator_to_m, "must be finite and > separator_from_m");
+    check.Fail("separator_to_m", separator_to_m, "must be finite and > separator_from_m");
   }
-  positive("separator_bin_m", separator_bin_m);
-  positive("separator_half_width_m", separator_half_width_m);
-  if (separator_min_points < 1) fail("separator_min_points", separator_min_points, "must be >= 1");
-  if (!(std::isfinite(separator_min_depth_m) && separator_min_depth_m >= 0)) {
-    fail("separator_min_depth_m", separator_min_depth_m, "must be finite and >= 0");
-  }
-  positive("separator_min_spacing_m", separator_min_spacing_m);
-  if (!(std::isfinite(viewer_on_line_m) && viewer_on_line_m >= 0)) {
-    fail("viewer_on_line_m", viewer_on_line_m, "must be finite and >= 0");
-  }
+  check.Positive("separator_bin_m", separator_bin_m);
+  check.Positive("separator_half_width_m", separator_half_width_m);
+  if (separator_min_points < 1) check.Fail("separator_min_points", separator_min_points, "must be >= 1");
+  check.NonNegative("separator_min_depth_m", separator_min_depth_m);
+  check.Positive("separator_min_spacing_m", separator_min_spacing_m);
+  check.NonNegative("viewer_on_line_m", viewer_on_line_m);
 }
 
 std::optional<BayRow> FindBayRow(const PointCloud& cloud, const std::vector<int>& ground,

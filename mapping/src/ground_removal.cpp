@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "internal/voxel_keys.hpp"
 #include "romo/core/check.hpp"
@@ -19,18 +18,13 @@ PlaneRansacParams GroundRemovalParams::DefaultRansac() {
 }
 
 void GroundRemovalParams::Validate() const {
-  const auto fail = [](const char* field, double value, const char* rule) {
-    std::ostringstream msg;
-    msg << "GroundRemovalParams." << field << " = " << value << ": " << rule;
-    Fail(msg.str());
-  };
-  if (!std::isfinite(prior_height_m)) fail("prior_height_m", prior_height_m, "must be finite");
-  if (!(std::isfinite(search_band_m) && search_band_m > 0.f)) fail("search_band_m", search_band_m, "must be finite and > 0");
-  if (!(std::isfinite(height_tolerance_m) && height_tolerance_m >= 0.f))
-    fail("height_tolerance_m", height_tolerance_m, "must be finite and >= 0");
-  if (!(below_tolerance_m >= 0.f)) fail("below_tolerance_m", below_tolerance_m, "must be >= 0 (or infinite)");
-  if (!(std::isfinite(below_sigmas) && below_sigmas >= 0.f)) fail("below_sigmas", below_sigmas, "must be finite and >= 0");
-  if (min_inliers < 3) fail("min_inliers", min_inliers, "must be >= 3");
+  const FieldCheck check("GroundRemovalParams");
+  if (!std::isfinite(prior_height_m)) check.Fail("prior_height_m", prior_height_m, "must be finite");
+  check.Positive("search_band_m", search_band_m);
+  check.NonNegative("height_tolerance_m", height_tolerance_m);
+  if (!(below_tolerance_m >= 0.f)) check.Fail("below_tolerance_m", below_tolerance_m, "must be >= 0 (or infinite)");
+  check.NonNegative("below_sigmas", below_sigmas);
+  if (min_inliers < 3) check.Fail("min_inliers", min_inliers, "must be >= 3");
   ransac.Validate();
 }
 

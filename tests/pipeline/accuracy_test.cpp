@@ -100,9 +100,14 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     EXPECT_LE(e.slot_yaw_err_deg, 3.0);
     EXPECT_EQ(e.narrow_reported_feasible(), 0) << e.MissesText();  // (the frames, with the slot behind each)
     // Hidden objects (about 40 car and 25 pedestrian sightings a scene) are neither missed nor
-    // found there.
+    // found there: every sighting is scored once, as visible or as hidden. (Visible recall is not
+    // bound to exceed the whole's: the memory finds 0.6-0.9 of the hidden cars.)
     EXPECT_LT(e.car_visible.truths, e.car.truths);
-    EXPECT_GE(e.car_visible.recall(), e.car.recall());
+    EXPECT_EQ(e.car_visible.truths + e.car_hidden.truths, e.car.truths);
+    EXPECT_EQ(e.car_visible.matched_truths + e.car_hidden.matched_truths, e.car.matched_truths);
+    EXPECT_EQ(e.pedestrian_visible.truths + e.pedestrian_hidden.truths, e.pedestrian.truths);
+    EXPECT_EQ(e.pedestrian_visible.matched_truths + e.pedestrian_hidden.matched_truths,
+              e.pedestrian.matched_truths);
     // `--misses` lists exactly the visible truths missed and the detections matched to none.
     std::int64_t missed = 0, false_alarms = 0;
     for (const ClassScore* c : {&e.car_visible, &e.pedestrian_visible}) {

@@ -884,12 +884,38 @@ class Pipeline::Impl {
     SetYaw(box, static_cast<float>(yaw_rad), up);
   }
 
+  // The bay between two separators (along the row) a car's width apart (bay_snap_*_width_m) where
+  // most of a blob's front part (@p points as RowPoints) lies; nullopt where none holds most.
+  std::optional<std::pair<double, double>> BayHolding(const std::vector<Eigen::Vector2d>& points,
+                                                      const mapping::BayRow& row) const {
+    const std::vector<double>& seps = row.separators_m;
+    std::vector<Eigen::Vector2d> front;
+    for (const Eigen::Vector2d& q : points) {
+      if (q.y() <= params.bay_front_m) front.push_back(q);
+    }
+    const std::vector<Eigen::Vector2d>& deciding = front.empty() ? points : front;
+    std::size_t best_bay = seps.size();
+    std::ptrdiff_t best_count = 0;
+    for (std::size_t k = 0; k + 1 < seps.size(); ++k) {
+      const double bay_width = seps[k + 1] - seps[k];
+      if (bay_width < params.bay_snap_min_width_m || bay_width > params.bay_snap_max_width_m) continue;
+      const auto count = std::count_if(deciding.begin(), deciding.end(), [&](const Eigen::Vector2d& q) {
+        return q.x() >= seps[k] && q.x() < seps[k + 1];
+      });
+      if (count > best_count) {
+        best_count = count;
+        best_bay = k;
+      }
+    }
+    if (best_bay == seps.size() || 2 * best_count <= static_cast<std::ptrdiff_t>(deciding.size())) return std::nullopt;
+    return std::make_pair(seps[best_bay], seps[best_bay + 1]);
+  }
+
   // Car boxes whose front part lies in one bay between two separators, but off its centre line or
   // its heading, are moved onto it; car boxes off the bays' heading where no bay is seen are turned
   // to it and centred on their face (PipelineParams::bay_snap_*).
   void SnapCarsToBays(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
                       std::vector<Seen>* seen) const {
-    const std::vector<double>& seps = row.separators_m;
     const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
     const double bay_heading = std::atan2(row.into_bays.y(), row.into_bays.x());
     for (std::size_t i = 0; i < r.boxes.size(); ++i) {
@@ -900,36 +926,18 @@ class Pipeline::Impl {
       const double centre_depth = row.Depth(centre);
       if (centre_depth < 0.0 || centre_depth > car.length.max_m) continue;  // not in this row
       const std::vector<Eigen::Vector2d> points = RowPoints(r, r.blobs[i], row);
-      std::vector<Eigen::Vector2d> front;
-      for (const Eigen::Vector2d& q : points) {
-        if (q.y() <= params.bay_front_m) front.push_back(q);
-      }
-      const std::vector<Eigen::Vector2d>& deciding = front.empty() ? points : front;
-      std::size_t best_bay = seps.size();
-      std::ptrdiff_t best_count = 0;
-      for (std::size_t k = 0; k + 1 < seps.size(); ++k) {
-        const double bay_width = seps[k + 1] - seps[k];
-        if (bay_width < params.bay_snap_min_width_m || bay_width > params.bay_snap_max_width_m) continue;
-        const auto count = std::count_if(deciding.begin(), deciding.end(), [&](const Eigen::Vector2d& q) {
-          return q.x() >= seps[k] && q.x() < seps[k + 1];
-        });
-        if (count > best_count) {
-          best_count = count;
-          best_bay = k;
-        }
-      }
+      const std::optional<std::pair<double, double>> bay = BayHolding(points, row);
       const bool off_heading = AxisAngle(box.yaw_rad, bay_heading) > params.bay_snap_min_off_deg * kPi / 180.0;
       const double length = std::max(box.size.x(), box.size.y());
       double width = std::min(box.size.x(), box.size.y());
-      double lateral = 0.0;
       // Seen far off, the face is smeared along the sight line, and the box with it; the face's far
       // end is never hidden, its near end rarely: its middle is the car's. In a bay, it is kept
       // within the bay's lines: a bay beside a free one is wider than its car on that side, so its
       // centre line is no car's.
       const RowFace face = FaceOf(points);
-      lateral = 0.5 * (face.lo_m + face.hi_m);
-      if (best_bay < seps.size() && 2 * best_count > static_cast<std::ptrdiff_t>(deciding.size())) {
-        const double lo = seps[best_bay], hi = seps[best_bay + 1];
+      double lateral = 0.5 * (face.lo_m + face.hi_m);
+      if (bay) {
+        const auto [lo, hi] = *bay;
         width = std::min(width, hi - lo);
         lateral = std::clamp(lateral, lo + 0.5 * width, hi - 0.5 * width);
         if (std::abs(row.Along(centre) - lateral) <= params.bay_snap_min_offset_m && !off_heading) continue;

@@ -17,6 +17,18 @@ class Error : public std::runtime_error {
 /// Throws romo::Error with @p message.
 [[noreturn]] void Fail(const std::string& message);
 
+/// Checks a parameter struct's fields: a failure throws romo::Error "Owner.field = value: rule".
+class FieldCheck {
+ public:
+  explicit FieldCheck(const char* owner) : owner_(owner) {}
+  [[noreturn]] void Fail(const char* field, double value, const char* rule) const;
+  void Positive(const char* field, double value) const;     ///< finite and > 0
+  void NonNegative(const char* field, double value) const;  ///< finite and >= 0
+
+ private:
+  const char* owner_;
+};
+
 namespace internal {
 [[noreturn]] void ThrowUnless(const char* condition, const char* func, const char* file, int line);
 [[noreturn]] void Abort(const char* condition, const char* func, const char* file, int line);

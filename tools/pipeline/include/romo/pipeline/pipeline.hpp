@@ -223,7 +223,8 @@ struct PipelineParams {
   /// off a car is seen as an end smeared along the sight line, its box follows the sight line
   /// (40-60 deg off) and lands between two bays, and its neighbours' ends are pieces too small
   /// for a car. false: boxes as seen. Pooled over seeds 1-10 (simulated scene), cars P / R
-  /// 0.906 / 0.717 -> 0.882 / 0.801, pedestrians 0.847 / 0.754 -> 0.855 / 0.765.
+  /// 0.906 / 0.717 -> 0.881 / 0.814, pedestrians 0.845 / 0.754 -> 0.856 / 0.764 (with the
+  /// memory fixes of the same session: GroundRemovalParams::below_tolerance_m, RememberParkedCars).
   bool bays_from_paint = true;
   mapping::BayRowParams bay_row;
   /// A box's or piece's front part: its points up to bay_front_m behind the front line. Its face:
