@@ -19,6 +19,7 @@
 #include "romo/drivers/recording.hpp"
 #include "romo/pipeline/scene_eval.hpp"
 #include "romo/planning_iface/messages.hpp"
+#include "romo/sim/ground_truth.hpp"
 #include "test_support.hpp"
 
 namespace romo::pipeline {
@@ -1016,6 +1017,50 @@ TEST(PipelineTest, MissesListEachFrameTheNarrowBayWasReportedFeasible) {
   e.logs = 2;
   e.narrow_feasible.front().log = 1;
   EXPECT_NE(e.MissesText().find("log 1 frame 34 narrow bay 2"), std::string::npos) << e.MissesText();
+}
+
+// A car straddling the 15 m edge is scored as neither a false detection (its truth just outside)
+// nor a miss (its box just outside); what lies wholly inside is scored as before.
+TEST(PipelineTest, EvalSceneLeavesPairsAcrossTheRangesEdgeUnscored) {
+  romo::test::ScratchDir dir;
+  const std::string log = dir / "edge.lcmlog";
+  {
+    drivers::LogWriter writer(log);
+    sim::GroundTruth truth;
+    truth.stamp_ns = 1'000'000'000;
+    const auto car = [](int id, double x, double y) {
+      sim::GtBox b;
+      b.id = id;
+      b.class_name = "car";
+      b.center_m = Eigen::Vector3d(x, y, 0.75);
+      b.size_m = Eigen::Vector3d(4.4, 1.8, 1.5);
+      return b;
+    };
+    truth.objects = {car(1, 14.5, 0.0), car(2, 15.6, 3.0), car(3, 10.0, 0.0)};  // car 2 is 15.9 m away
+    const auto truth_bytes = sim::Encode(truth);
+    writer.WriteRaw(sim::kGroundTruthChannel, truth.stamp_ns, truth_bytes.data(), truth_bytes.size());
+    planning_iface::ObstacleList list;
+    list.stamp_ns = truth.stamp_ns;
+    for (const Eigen::Vector2d& at : {Eigen::Vector2d(15.3, 0.0),   // car 1's box, 15.3 m away
+                                      Eigen::Vector2d(14.6, 3.0),   // car 2's, 14.9 m away
+                                      Eigen::Vector2d(5.0, 5.0)}) {  // nothing there
+      planning_iface::Obstacle o;
+      o.class_name = "car";
+      o.center_m = Eigen::Vector3d(at.x(), at.y(), 0.75);
+      o.size_m = Eigen::Vector3d(4.4, 1.8, 1.5);
+      o.num_points = 100;
+      list.obstacles.push_back(o);
+    }
+    const auto list_bytes = planning_iface::Encode(list);
+    writer.WriteRaw(planning_iface::kObstaclesChannel, list.stamp_ns, list_bytes.data(), list_bytes.size());
+  }
+  const SceneEval e = EvaluateSceneLog(log);
+  ASSERT_EQ(e.frames, 1);
+  EXPECT_EQ(e.car.truths, 2);              // cars 1 and 3
+  EXPECT_EQ(e.car.detections, 2);          // car 1's box and the one at (5, 5)
+  EXPECT_EQ(e.car.matched_truths, 1);      // car 1
+  EXPECT_DOUBLE_EQ(e.car.precision(), 0.5);
+  EXPECT_DOUBLE_EQ(e.car.recall(), 0.5);
 }
 
 // Several runs (seeds) scored as one: what each run counts adds up, and the lists name the run.

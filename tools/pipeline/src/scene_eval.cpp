@@ -49,6 +49,16 @@ std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth
   return out;
 }
 
+// Keeps the entries of @p v whose @p new_index is >= 0 (ascending), at that index.
+template <class T>
+void Compact(std::vector<T>* v, const std::vector<int>& new_index) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < v->size(); ++i) {
+    if (new_index[i] >= 0) (*v)[kept++] = (*v)[i];
+  }
+  v->resize(kept);
+}
+
 // A world-frame heading as seen in the frame @p T_to maps into.
 double HeadingIn(const Eigen::Isometry3d& T_to, double yaw_rad) {
   const Eigen::Vector3d heading = T_to.linear() * Eigen::Vector3d(std::cos(yaw_rad), std::sin(yaw_rad), 0.0);
@@ -181,10 +191,15 @@ void Scorer::Add(const std::string& log_path, int log_index) {
       std::vector<double> truth_visible_fraction;
       std::vector<const sim::GtBox*> truth_box;
       std::vector<const pi::Obstacle*> det_box;
+      // Objects up to a match gate past the range are matched too, so that a car straddling the
+      // edge is neither a false detection (its truth just outside) nor a miss (its box just outside):
+      // either pair is left unscored, like the objects beyond.
+      const double gate = cls == "car" ? params_.car_match_m : params_.pedestrian_match_m;
+      const double reach = params_.range_m + gate;
       for (const auto& o : f.truth->objects) {
         if (o.class_name != cls) continue;
         const Eigen::Vector2d v = (T_vw * o.center_m).head<2>();
-        if (v.norm() > params_.range_m) continue;
+        if (v.norm() > reach) continue;
         truth.push_back(v);
         truth_id.push_back(o.id);
         truth_box.push_back(&o);
@@ -193,12 +208,42 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         truth_visible.push_back(calibration && visible >= params_.min_visible_fraction);
       }
       for (const auto& o : f.obstacles->obstacles) {
-        if (o.class_name != cls || o.center_m.head<2>().norm() > params_.range_m) continue;
+        if (o.class_name != cls || o.center_m.head<2>().norm() > reach) continue;
         det.push_back(o.center_m.head<2>());
         det_track.push_back(o.track_id);
         det_box.push_back(&o);
       }
-      const auto m = Match(truth, det, cls == "car" ? params_.car_match_m : params_.pedestrian_match_m);
+      std::vector<std::pair<int, int>> m = Match(truth, det, gate);
+      {
+        // Scored: the truths within range, the detections matched to them, and the unmatched
+        // detections within range.
+        std::vector<int> det_truth(det.size(), -1);
+        for (const auto& [i, j] : m) det_truth[static_cast<std::size_t>(j)] = i;
+        std::vector<int> truth_index(truth.size(), -1), det_index(det.size(), -1);
+        int kept = 0;
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+          if (truth[i].norm() <= params_.range_m) truth_index[i] = kept++;
+        }
+        kept = 0;
+        for (std::size_t j = 0; j < det.size(); ++j) {
+          const int t = det_truth[j];
+          if (t >= 0 ? truth_index[static_cast<std::size_t>(t)] >= 0 : det[j].norm() <= params_.range_m) det_index[j] = kept++;
+        }
+        std::vector<std::pair<int, int>> scored;
+        for (const auto& [i, j] : m) {
+          const int t = truth_index[static_cast<std::size_t>(i)];
+          if (t >= 0) scored.emplace_back(t, det_index[static_cast<std::size_t>(j)]);
+        }
+        m = std::move(scored);
+        Compact(&truth, truth_index);
+        Compact(&truth_id, truth_index);
+        Compact(&truth_box, truth_index);
+        Compact(&truth_visible, truth_index);
+        Compact(&truth_visible_fraction, truth_index);
+        Compact(&det, det_index);
+        Compact(&det_track, det_index);
+        Compact(&det_box, det_index);
+      }
       ClassScore& score = cls == "car" ? out_.car : out_.pedestrian;
       score.truths += static_cast<std::int64_t>(truth.size());
       score.detections += static_cast<std::int64_t>(det.size());
