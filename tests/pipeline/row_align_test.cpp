@@ -58,16 +58,24 @@ TEST(RowAlignTest, FarCarsSeenObliquelyInARowAreBoxedAlongIt) {
   auto* sim_source = dynamic_cast<sim::SimSource*>(source.get());
   ASSERT_NE(sim_source, nullptr);
   const drivers::Calibration calibration = *source->calibration();
-  const PipelineParams aligned = PipelineParams::ForCalibration(calibration, 2);
+  // The row's paint (bays_from_paint) heads these boxes too: off here, so that the row's heading
+  // from its cars is what is measured, and on (the default) for what the two give together.
+  const PipelineParams painted = PipelineParams::ForCalibration(calibration, 2);
+  PipelineParams aligned = painted;
+  aligned.bays_from_paint = false;
   PipelineParams unaligned = aligned;
   unaligned.row_align_min_cars = 0;
-  FarCarScore with_row, without_row;
+  FarCarScore with_row, without_row, with_paint;
   for (int f = 0; f < kFrames; ++f) {
     const std::optional<drivers::FrameSet> frames = source->Next();
     ASSERT_TRUE(frames.has_value());
     Score(sim_source->ground_truth(), Pipeline(calibration, aligned).Process(*frames), &with_row);
     Score(sim_source->ground_truth(), Pipeline(calibration, unaligned).Process(*frames), &without_row);
+    Score(sim_source->ground_truth(), Pipeline(calibration, painted).Process(*frames), &with_paint);
   }
+  std::printf("FIGURE row align: with the row's paint too, matched %d/%d, boxed within %.0f deg %d, yaw error median "
+              "%.1f deg\n",
+              with_paint.matched, with_paint.truths, kAlongDeg, with_paint.along, Median(with_paint.yaw_err_deg));
   std::printf("FIGURE row align: far cars (%.0f-%.0f m) matched %d/%d with the row's heading, %d/%d without; "
               "boxed within %.0f deg of the car %d and %d; yaw error median %.1f deg with, %.1f without\n",
               kNearM, kFarM, with_row.matched, with_row.truths, without_row.matched, without_row.truths, kAlongDeg,
@@ -82,6 +90,10 @@ TEST(RowAlignTest, FarCarsSeenObliquelyInARowAreBoxedAlongIt) {
   EXPECT_GE(with_row.matched, without_row.matched + 1);
   EXPECT_GE(with_row.along, without_row.along + 3);
   EXPECT_LT(Median(with_row.yaw_err_deg), Median(without_row.yaw_err_deg) - 0.5);
+  // Measured with the paint: 58 of 67 matched, 39 along, yaw 5.4 deg.
+  EXPECT_GE(with_paint.matched, with_row.matched);
+  EXPECT_GE(with_paint.along, with_row.along + 10);
+  EXPECT_LT(Median(with_paint.yaw_err_deg), 0.5 * Median(with_row.yaw_err_deg));
 }
 
 }  // namespace
