@@ -374,6 +374,10 @@ class Pipeline::Impl {
     parked_from_steady_view.erase(it->first);
     return parked.erase(it);
   }
+  // Two car detections (one frame) are of one car when their centres lie within half the longer.
+  static bool SameCar(const objects::Detection& a, const objects::Detection& b) {
+    return (a.xy_m - b.xy_m).norm() < 0.5 * std::max(a.length_m, b.length_m);
+  }
   // Remembers the static car tracks seen as cars now (PipelineParams::parked_*).
   void RememberParkedCars(const FrameResult& r, const std::vector<objects::Track>& tracks,
                           const std::vector<objects::Detection>& detections) {
@@ -406,15 +410,13 @@ class Pipeline::Impl {
       // take the blobs of cars they pass): the car remembered stays, and this one is not
       // remembered under that track.
       const auto remembered = parked.find(tr.id);
-      if (remembered != parked.end() &&
-          (remembered->second.xy_m - car.xy_m).norm() >= 0.5 * std::max(remembered->second.length_m, car.length_m)) {
+      if (remembered != parked.end() && !SameCar(remembered->second, car)) {
         continue;
       }
       // The same car remembered under an earlier track (an ID switch, or a replay looping back)
       // is replaced, not listed twice.
       for (auto it = parked.begin(); it != parked.end();) {
-        const bool same_car = it->first != tr.id && (it->second.xy_m - car.xy_m).norm() <
-                                                        0.5 * std::max(it->second.length_m, car.length_m);
+        const bool same_car = it->first != tr.id && SameCar(it->second, car);
         it = same_car ? ForgetParkedCar(it) : std::next(it);
       }
       parked[tr.id] = car;
@@ -917,7 +919,7 @@ class Pipeline::Impl {
   void SnapCarsToBays(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
                       std::vector<Seen>* seen) const {
     const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
-    const double bay_heading = std::atan2(row.into_bays.y(), row.into_bays.x());
+    const double bay_heading = row.HeadingRad();
     for (std::size_t i = 0; i < r.boxes.size(); ++i) {
       Seen& v = (*seen)[i];
       if (!v.on_ground || v.framed || v.viewed.classification.class_index != car_class) continue;
@@ -974,7 +976,7 @@ class Pipeline::Impl {
   void CompleteFacesInRow(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
                           std::vector<Seen>* seen) const {
     const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
-    const double bay_heading = std::atan2(row.into_bays.y(), row.into_bays.x());
+    const double bay_heading = row.HeadingRad();
     const double length = car.length.mean_m, width = car.width.mean_m;
     std::vector<Eigen::Vector2d> car_centres;
     for (const Seen& v : *seen) {

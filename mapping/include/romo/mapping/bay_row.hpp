@@ -5,6 +5,7 @@
 /// line (40-60 deg off) and lands between two bays. The paint gives both its heading and its bay.
 /// Paint differs from asphalt in brightness, not in height, so it is found on the grey values of
 /// the ground points.
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -57,6 +58,8 @@ struct BayRow {
 
   double Along(const Eigen::Vector2d& xy) const { return along.dot(xy - origin); }
   double Depth(const Eigen::Vector2d& xy) const { return into_bays.dot(xy - origin); }
+  /// The bays' heading (into_bays) about z.
+  double HeadingRad() const { return std::atan2(into_bays.y(), into_bays.x()); }
 };
 
 /// The row whose front line holds paint over the most length among the points @p ground of
