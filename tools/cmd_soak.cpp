@@ -87,6 +87,38 @@ TracksPerLoop CompareLoops(const std::vector<Sample>& measured) {
   return result;
 }
 
+// Resident memory at the same point of every whole loop: the lowest and the highest sample of
+// each. Within a loop RSS swings by ~15 MB as large buffers are mapped and unmapped, so a fit
+// over the raw samples moves with the phase the window happens to end at (+3.1 MB/min once with
+// first and last samples 0.3 MB apart); a leak lifts both the floor and the peak of every loop.
+struct LoopExtremes {
+  std::vector<Sample> floors, peaks;  // one per whole loop, at the loop's mean time
+};
+
+LoopExtremes RssPerLoop(const std::vector<Sample>& measured) {
+  LoopExtremes result;
+  if (measured.empty()) return result;
+  const std::int64_t first = measured.front().loop + 1, last = measured.back().loop - 1;
+  std::map<std::int64_t, std::vector<const Sample*>> by_loop;
+  for (const auto& s : measured) {
+    if (s.loop >= first && s.loop <= last) by_loop[s.loop].push_back(&s);
+  }
+  for (const auto& [loop, samples] : by_loop) {
+    Sample floor, peak;
+    floor.rss_mb = 1e300, peak.rss_mb = -1e300;
+    for (const Sample* s : samples) {
+      floor.t_s += s->t_s / static_cast<double>(samples.size());
+      floor.rss_mb = std::min(floor.rss_mb, s->rss_mb);
+      peak.rss_mb = std::max(peak.rss_mb, s->rss_mb);
+    }
+    peak.t_s = floor.t_s;
+    floor.loop = peak.loop = loop;
+    result.floors.push_back(floor);
+    result.peaks.push_back(peak);
+  }
+  return result;
+}
+
 // Resident set size from /proc/self/status ("VmRSS:   123456 kB"), in MB (1e6 bytes).
 double ResidentMb() {
   std::ifstream status("/proc/self/status");
@@ -216,7 +248,13 @@ void Soak(const SoakOptions& o) {
     Fail("soak: only " + std::to_string(measured.size()) + " frames after the " + std::to_string(o.warmup_s) +
          " s warm-up: run longer (--duration) or warm up shorter (--warmup)");
   }
-  const Fit rss = LeastSquares(measured, &Sample::rss_mb);
+  const LoopExtremes rss_loops = RssPerLoop(measured);
+  // Fewer than 3 whole loops (a long recording or a slow host) leave only the raw samples.
+  const bool loops_fit = rss_loops.peaks.size() >= 3;
+  const Fit rss_samples = LeastSquares(measured, &Sample::rss_mb);
+  const Fit rss_floor = loops_fit ? LeastSquares(rss_loops.floors, &Sample::rss_mb) : rss_samples;
+  const Fit rss_peak = loops_fit ? LeastSquares(rss_loops.peaks, &Sample::rss_mb) : rss_samples;
+  const double rss_slope = std::max(rss_floor.slope, rss_peak.slope);
   const Fit latency = LeastSquares(measured, &Sample::latency_ms);
   const Fit cpu = LeastSquares(measured, &Sample::cpu_ms);
   const TracksPerLoop tracks = CompareLoops(measured);
@@ -241,7 +279,9 @@ void Soak(const SoakOptions& o) {
     std::snprintf(text, sizeof text,
                   "{\n  \"log\": \"%s\",\n  \"duration_s\": %.1f,\n  \"warmup_s\": %.1f,\n  \"frames\": %lld,\n"
                   "  \"frames_measured\": %zu,\n  \"loops\": %lld,\n  \"skipped_out_of_order\": %lld,\n"
-                  "  \"rss_mb\": {\"first\": %.2f, \"last\": %.2f, \"max\": %.2f, \"mean\": %.2f, \"slope_mb_per_min\": %.4f},\n"
+                  "  \"rss_mb\": {\"first\": %.2f, \"last\": %.2f, \"max\": %.2f, \"mean\": %.2f, \"slope_mb_per_min\": %.4f, "
+                  "\"floor_slope_mb_per_min\": %.4f, \"peak_slope_mb_per_min\": %.4f, \"sample_slope_mb_per_min\": %.4f, "
+                  "\"loops_fitted\": %zu},\n"
                   "  \"latency_ms\": {\"mean\": %.2f, \"p50\": %.2f, \"p95\": %.2f, \"slope_ms_per_min\": %.4f},\n"
                   "  \"cpu_ms_per_frame\": {\"mean\": %.2f, \"slope_ms_per_min\": %.4f},\n"
                   "  \"tracks_per_frame\": {\"first_loop\": %.3f, \"last_loop\": %.3f, \"loops_compared\": %lld, "
@@ -249,21 +289,23 @@ void Soak(const SoakOptions& o) {
                   JsonEscape(o.log).c_str(), wall_s, o.warmup_s, static_cast<long long>(stats.frames), measured.size(),
                   static_cast<long long>(looped.loops()), static_cast<long long>(stats.skipped_out_of_order),
                   measured.front().rss_mb, measured.back().rss_mb,
-                  *std::max_element(rss_values.begin(), rss_values.end()), rss.mean, rss.slope, latency.mean,
+                  *std::max_element(rss_values.begin(), rss_values.end()), rss_samples.mean, rss_slope, rss_floor.slope,
+                  rss_peak.slope, rss_samples.slope, loops_fit ? rss_loops.peaks.size() : std::size_t{0}, latency.mean,
                   Percentile(latencies, 0.5), Percentile(latencies, 0.95), latency.slope, cpu.mean, cpu.slope, tracks.first, tracks.last,
                   static_cast<long long>(tracks.loops_compared), tracks.first_mean, tracks.last_mean,
                   static_cast<long long>(tracks.loops_averaged));
     json << text;
   }
   cv::Mat plot(3 * 260 + 20, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
-  DrawPanel(&plot, cv::Rect(10, 10, 980, 250), samples, &Sample::rss_mb, rss, o.warmup_s, "resident memory (MB)");
+  DrawPanel(&plot, cv::Rect(10, 10, 980, 250), samples, &Sample::rss_mb, rss_peak, o.warmup_s,
+            loops_fit ? "resident memory (MB), fit of loop peaks" : "resident memory (MB)");
   DrawPanel(&plot, cv::Rect(10, 270, 980, 250), samples, &Sample::latency_ms, latency, o.warmup_s, "frame latency (ms, wall)");
   DrawPanel(&plot, cv::Rect(10, 530, 980, 250), samples, &Sample::cpu_ms, cpu, o.warmup_s, "CPU per frame (ms)");
   cv::imwrite(o.out_dir + "/soak.png", plot);
-  std::printf("soak: %lld frames (%lld loops of %s) in %.1f s; after %.0f s warm-up: RSS %.1f MB slope %+.3f MB/min, "
+  std::printf("soak: %lld frames (%lld loops of %s) in %.1f s; after %.0f s warm-up: RSS %.1f MB, loop floor/peak slope %+.3f MB/min, "
               "latency mean %.1f ms slope %+.3f ms/min, CPU %.1f ms/frame slope %+.3f ms/min; %s/soak.{json,csv,png}\n",
               static_cast<long long>(stats.frames), static_cast<long long>(looped.loops()), o.log.c_str(), wall_s,
-              o.warmup_s, rss.mean, rss.slope, latency.mean, latency.slope, cpu.mean, cpu.slope, o.out_dir.c_str());
+              o.warmup_s, rss_samples.mean, rss_slope, latency.mean, latency.slope, cpu.mean, cpu.slope, o.out_dir.c_str());
 }
 
 }  // namespace
