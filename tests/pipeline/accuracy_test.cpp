@@ -116,6 +116,11 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
     }
     EXPECT_EQ(static_cast<std::int64_t>(e.misses.size()), missed);
     EXPECT_EQ(static_cast<std::int64_t>(e.false_alarms.size()), false_alarms);
+    // ... then the hidden ones the cameras saw before that memory did not carry.
+    EXPECT_EQ(static_cast<std::int64_t>(e.hidden_misses.size()),
+              e.car_hidden.seen_before - e.car_hidden.seen_before_matched + e.pedestrian_hidden.seen_before -
+                  e.pedestrian_hidden.seen_before_matched);
+    for (const SceneMiss& m : e.hidden_misses) EXPECT_LT(m.visible_fraction, SceneEvalParams{}.min_visible_fraction);
     // ... and each frame whose fully visible feasible bay was not found.
     EXPECT_EQ(static_cast<std::int64_t>(e.slot_misses.size()), e.slot_visible_frames - e.slot_found_frames);
     for (const SceneSlotMiss& m : e.slot_misses) {

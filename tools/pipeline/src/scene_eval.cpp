@@ -271,6 +271,11 @@ void Scorer::Add(const std::string& log_path, int log_index) {
           hidden.matched_truths += matched[i];
           hidden.seen_before += seen_before;
           hidden.seen_before_matched += seen_before && matched[i];
+          if (seen_before && !matched[i]) {
+            out_.hidden_misses.push_back(DescribeMiss(log_index, frame_index, cls, truth_id[i], truth[i],
+                                                      HeadingIn(T_vw, truth_box[i]->yaw_rad),
+                                                      truth_visible_fraction[i], f.obstacles->obstacles));
+          }
         }
         for (std::size_t j = 0; j < det.size(); ++j) {
           if (used[j]) continue;
@@ -399,7 +404,9 @@ SceneEval Scorer::Finish() {
   out.visibility_scored = out.logs > 0 && calibrated_logs_ == out.logs;
   if (!out.visibility_scored) {
     out.car_visible = out.pedestrian_visible = ClassScore{};
+    out.car_hidden = out.pedestrian_hidden = HiddenScore{};
     out.misses.clear();
+    out.hidden_misses.clear();
     out.false_alarms.clear();
   }
   out.box_center_err_m_median = Median(center_errors_);
@@ -512,18 +519,22 @@ std::string SceneEval::ToText() const {
 std::string SceneEval::MissesText() const {
   std::ostringstream t;
   t.precision(3);
-  for (const SceneMiss& m : misses) {
-    t << Where(logs, m.log, m.frame) << " " << m.class_name << " " << m.truth_id << " at (" << m.x_m << ", " << m.y_m
-      << ") m, " << 100 * m.visible_fraction << "% visible: ";
-    if (m.nearest_class.empty()) {
-      t << "nothing within 3 m\n";
-    } else {
-      t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away (" << m.nearest_along_m << " along, "
-        << m.nearest_across_m << " across its length), " << m.nearest_length_m << " x "
-        << m.nearest_width_m << " x " << m.nearest_height_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, "
-        << m.nearest_points << " points\n";
+  auto list_misses = [&](const std::vector<SceneMiss>& list, const char* visibility) {
+    for (const SceneMiss& m : list) {
+      t << Where(logs, m.log, m.frame) << " " << m.class_name << " " << m.truth_id << " at (" << m.x_m << ", "
+        << m.y_m << ") m, " << 100 * m.visible_fraction << visibility;
+      if (m.nearest_class.empty()) {
+        t << "nothing within 3 m\n";
+      } else {
+        t << "nearest " << m.nearest_class << " " << m.nearest_m << " m away (" << m.nearest_along_m << " along, "
+          << m.nearest_across_m << " across its length), " << m.nearest_length_m << " x " << m.nearest_width_m
+          << " x " << m.nearest_height_m << " m, yaw off " << m.nearest_yaw_err_deg << " deg, " << m.nearest_points
+          << " points\n";
+      }
     }
-  }
+  };
+  list_misses(misses, "% visible: ");
+  list_misses(hidden_misses, "% visible, hidden now (seen before): ");
   for (const SceneFalseAlarm& a : false_alarms) {
     t << Where(logs, a.log, a.frame) << " false " << a.class_name << " at (" << a.x_m << ", " << a.y_m << ") m, "
       << a.length_m << " x " << a.width_m << " x " << a.height_m << " m, " << a.points

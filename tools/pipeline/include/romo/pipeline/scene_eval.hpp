@@ -110,6 +110,9 @@ struct SceneEval {
   double slot_center_err_m = 0.0;  ///< median over found frames
   double slot_yaw_err_deg = 0.0;   ///< median over found frames
   std::vector<SceneMiss> misses;  ///< visible truths missed (only when visibility_scored)
+  /// Truths hidden now that the cameras saw earlier in the run, missed (what memory and coasting
+  /// tracks failed to carry; only when visibility_scored).
+  std::vector<SceneMiss> hidden_misses;
   std::vector<SceneFalseAlarm> false_alarms;  ///< unmatched detections (only when visibility_scored)
   std::vector<SceneSlotMiss> slot_misses;  ///< visible feasible bays not found
   std::vector<SceneNarrowFeasible> narrow_feasible;  ///< each frame the narrow bay was reported feasible
@@ -118,6 +121,7 @@ struct SceneEval {
   std::string ToJson() const;
   std::string ToText() const;
   /// One line per miss (frame, class, where, visibility, the nearest detection), then one per
+  /// hidden truth seen before and missed now (the same, marked "hidden now"), then one per
   /// false alarm (where, size, the nearest truth), then one per visible feasible bay not found
   /// (where, the nearest slot reported and why it was infeasible), then one per narrow bay
   /// reported feasible (where, the slot's length and the neighbours that bounded it).
