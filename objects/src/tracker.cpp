@@ -37,6 +37,8 @@ struct TrackState_ {
   Mat4 P = Mat4::Zero();
   std::unique_ptr<PathPredictor> predictor;
   int misses = 0;
+  Eigen::Vector2d companion_offset = Eigen::Vector2d::Zero();  // from the companion, when lost
+  bool following = false;         // placed by its companion this frame
   std::vector<int> votes;         // per Atlas class
   std::vector<double> vote_score;  // summed scores per class
 };
@@ -83,6 +85,12 @@ void TrackerParams::Validate() const {
   if (max_tracks_per_blob < 1) bad("max_tracks_per_blob", max_tracks_per_blob, "need >= 1");
   if (!(merged_inset_m >= 0.0)) bad("merged_inset_m", merged_inset_m, "need >= 0");
   if (!(merged_sigma_m > 0.0)) bad("merged_sigma_m", merged_sigma_m, "need > 0");
+  if (!(companion_max_gap_m >= 0.0)) bad("companion_max_gap_m", companion_max_gap_m, "need >= 0 (0 = off)");
+  if (!(companion_min_speed_mps >= 0.0)) bad("companion_min_speed_mps", companion_min_speed_mps, "need >= 0");
+  if (!(companion_max_speed_diff_mps >= 0.0)) {
+    bad("companion_max_speed_diff_mps", companion_max_speed_diff_mps, "need >= 0");
+  }
+  if (!(companion_max_occlusion_s >= 0.0)) bad("companion_max_occlusion_s", companion_max_occlusion_s, "need >= 0");
   predictor.Validate();
 }
 
@@ -113,6 +121,7 @@ class Tracker::Impl {
   bool MayHoldSeveral(const Detection& d) const;
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
   double MaxOcclusion(const TrackState_& s) const;
+  void FollowCompanions(const std::vector<char>& updated);
   void Observe(TrackState_* s, const Detection& d, double stamp_s) const;
 };
 
@@ -169,6 +178,53 @@ double Tracker::Impl::MaxOcclusion(const TrackState_& s) const {
     limit = std::max(limit, atlas_.classes()[static_cast<std::size_t>(s.track.class_index)].max_occlusion_s);
   }
   return limit;
+}
+
+void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
+  // Companions: pedestrian tracks measured alone now and walking.
+  const double min_speed = params_.companion_min_speed_mps;
+  std::vector<std::size_t> walking;
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    const TrackState_& c = states_[i];
+    if (updated[i] && !c.track.merged && c.track.class_index == pedestrian_ && c.x.tail<2>().norm() >= min_speed) {
+      walking.push_back(i);
+    }
+  }
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    TrackState_& s = states_[i];
+    Track& t = s.track;
+    s.following = false;
+    if (updated[i]) {
+      t.companion_id = -1;
+      continue;
+    }
+    if (t.state == TrackState::kTentative || t.class_index != pedestrian_) continue;
+    if (t.companion_id < 0 && s.misses == 0) {
+      // Lost just now: the nearest walker beside it moving alike (the predictions still agree).
+      double best = params_.companion_max_gap_m;
+      for (std::size_t k : walking) {
+        const TrackState_& c = states_[k];
+        const double gap = (s.x.head<2>() - c.x.head<2>()).norm();
+        if (gap <= best && (s.x.tail<2>() - c.x.tail<2>()).norm() <= params_.companion_max_speed_diff_mps) {
+          best = gap;
+          t.companion_id = c.track.id;
+          s.companion_offset = s.x.head<2>() - c.x.head<2>();
+        }
+      }
+    }
+    if (t.companion_id < 0) continue;
+    const auto c = std::find_if(walking.begin(), walking.end(),
+                                [&](std::size_t k) { return states_[k].track.id == t.companion_id; });
+    if (c == walking.end()) {
+      t.companion_id = -1;  // the companion is hidden or stopped too: coast alone from here
+      continue;
+    }
+    const TrackState_& companion = states_[*c];
+    s.x.head<2>() = companion.x.head<2>() + s.companion_offset;
+    s.x.tail<2>() = companion.x.tail<2>();
+    s.P = companion.P;
+    s.following = true;
+  }
 }
 
 void Tracker::Impl::Observe(TrackState_* s, const Detection& d, double stamp_s) const {
@@ -311,6 +367,8 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     }
   }
 
+  if (params_.companion_max_gap_m > 0.0) FollowCompanions(updated);
+
   // Lifecycle of every existing track.
   std::vector<TrackState_> kept;
   kept.reserve(states_.size() + detections.size());
@@ -333,7 +391,8 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
         }
       } else {
         t.state = TrackState::kLost;
-        if (stamp_s - t.last_seen_s > MaxOcclusion(s)) {
+        const double limit = s.following ? std::max(MaxOcclusion(s), params_.companion_max_occlusion_s) : MaxOcclusion(s);
+        if (stamp_s - t.last_seen_s > limit) {
           ++deleted_;
           continue;
         }

@@ -169,6 +169,32 @@ TEST(TrackerTest, OcclusionLongerThanLimitEndsTrack) {
   EXPECT_EQ(r.tracks_created, 2);
 }
 
+TEST(TrackerTest, HiddenWalkerFollowsTheCompanionSeenBesideIt) {
+  // Two people walk side by side 1 m apart; the far one is hidden behind the near one for 4 s
+  // (twice the pedestrian's 2 s coasting limit), during which both turn 45 degrees and slow down.
+  std::vector<Walker> walkers = {
+      {1, {-4.0, 0.0}, {1.3, 0.0}},
+      {2, {-4.0, 1.0}, {1.3, 0.0}, 2.0, 6.0},
+  };
+  for (Walker& w : walkers) {
+    w.turn_s = 3.5;
+    w.velocity_after = Eigen::Vector2d(0.7, 0.7);
+  }
+  // Followed: the track survives, stays beside its companion and takes the walker back.
+  const SceneResult followed = RunScene(walkers, 8.0);
+  EXPECT_EQ(followed.tracks_created, 2) << "the hidden walker's track must survive the 4 s";
+  EXPECT_EQ(followed.score.id_switches, 0);
+  EXPECT_GE(followed.lost_frames, 39);  // all 40 hidden frames reported (at most one re-association frame short)
+  EXPECT_LT(followed.score.max_error_m, kMaxErrorM);
+  // Coasting alone, the track runs on straight at the old speed and is dropped after 2 s: the
+  // walker comes back as a new track.
+  TrackerParams alone;
+  alone.companion_max_gap_m = 0.0;
+  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
+  EXPECT_EQ(coasted.tracks_created, 3);
+  EXPECT_GT(coasted.score.misses, followed.score.misses + 15);
+}
+
 TEST(TrackerTest, MergedPedestriansBothSurviveAndSplit) {
   // Two walkers pass each other head-on 0.6 m apart: for ~0.6 s stereo sees one blob
   // (Fig. 4.16 bottom); both tracks must share it and come out with their own ids.
@@ -276,6 +302,9 @@ TEST(TrackerTest, RejectsBadInput) {
   TrackerParams params;
   params.gate_chi2 = -1.0;
   EXPECT_THROW(Tracker(atlas, params), romo::Error);
+  params = TrackerParams{};
+  params.companion_max_gap_m = std::nan("");
+  EXPECT_NE(test::ErrorOf([&] { Tracker t(atlas, params); }).find("companion_max_gap_m = nan"), std::string::npos);
   Tracker tracker(atlas, TrackerParams{});
   tracker.Update(1.0, {});
   EXPECT_THROW(tracker.Update(1.0, {}), romo::Error);

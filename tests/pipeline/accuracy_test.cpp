@@ -186,11 +186,13 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // -> 1.4 deg, centre 0.245 -> 0.266 m (far cars now found are boxed from their face with the
   // Atlas car's mean length), slot 160/160 -> 159/160. Then pairs matched across the 15 m edge
   // left unscored (the truth on one side, its box on the other): car P 0.913 -> 0.917, R 0.860 ->
-  // 0.863, pedestrian P 0.872 -> 0.873, R 0.749 -> 0.759.
+  // 0.863, pedestrian P 0.872 -> 0.873, R 0.749 -> 0.759. Session 26: a pedestrian hidden by
+  // the one walking beside it follows that companion (TrackerParams::companion_*): pedestrian
+  // P 0.873 -> 0.902, R 0.759 -> 0.764, car P 0.917 -> 0.912.
   EXPECT_GE(mean.car_p, 0.90);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
-  EXPECT_GE(mean.ped_p, 0.86);
+  EXPECT_GE(mean.ped_p, 0.88);
   EXPECT_GE(mean.ped_r, 0.74);
   EXPECT_GE(mean.ped_visible_r, 0.80);
   EXPECT_LE(mean.centre_m, 0.275);

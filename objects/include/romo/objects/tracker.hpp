@@ -53,6 +53,7 @@ struct Track {
   double last_seen_s = 0.0;       ///< time of the last associated detection
   int hits = 0;                   ///< associated detections so far
   bool merged = false;            ///< shares a merged blob with another track this frame
+  int companion_id = -1;          ///< lost: the track it follows (TrackerParams::companion_*), or -1
   int detection_index = -1;       ///< detection associated this frame, or -1
   /// Last observed position (the RLS trail's newest point) and its time.
   Eigen::Vector2d observed_xy_m = Eigen::Vector2d::Zero();
@@ -81,6 +82,16 @@ struct TrackerParams {
   /// of their predictions: each centre lies this far inside the blob's end (half a body).
   double merged_inset_m = 0.25;
   double merged_sigma_m = 0.3;         ///< noise of that in-blob position
+  /// People walking together (side by side, or one behind the other along the sight line) hide
+  /// each other: a pedestrian track lost while another pedestrian track within
+  /// companion_max_gap_m is measured walking (at least companion_min_speed_mps) at nearly its
+  /// velocity (within companion_max_speed_diff_mps) follows that companion at the offset it had
+  /// when lost, for up to companion_max_occlusion_s while the companion stays measured, instead
+  /// of coasting on its own velocity. 0 gap = off.
+  double companion_max_gap_m = 1.6;
+  double companion_min_speed_mps = 0.4;
+  double companion_max_speed_diff_mps = 0.5;
+  double companion_max_occlusion_s = 8.0;
   PredictorParams predictor;           ///< path prediction for predict_path classes
   /// @throws romo::Error naming the field and value.
   void Validate() const;
