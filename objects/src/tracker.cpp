@@ -38,7 +38,6 @@ struct TrackState_ {
   std::unique_ptr<PathPredictor> predictor;
   int misses = 0;
   Eigen::Vector2d companion_offset = Eigen::Vector2d::Zero();  // from the companion, when lost
-  bool following = false;         // placed by its companion this frame
   std::vector<int> votes;         // per Atlas class
   std::vector<double> vote_score;  // summed scores per class
 };
@@ -177,6 +176,8 @@ double Tracker::Impl::MaxOcclusion(const TrackState_& s) const {
   if (s.track.class_index >= 0) {
     limit = std::max(limit, atlas_.classes()[static_cast<std::size_t>(s.track.class_index)].max_occlusion_s);
   }
+  // Placed by its companion this frame (FollowCompanions): it is where the companion is seen.
+  if (s.track.companion_id >= 0) limit = std::max(limit, params_.companion_max_occlusion_s);
   return limit;
 }
 
@@ -193,12 +194,10 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
     Track& t = s.track;
-    s.following = false;
-    if (updated[i]) {
+    if (updated[i] || t.state == TrackState::kTentative || t.class_index != pedestrian_) {
       t.companion_id = -1;
       continue;
     }
-    if (t.state == TrackState::kTentative || t.class_index != pedestrian_) continue;
     if (t.companion_id < 0 && s.misses == 0) {
       // Lost just now: the nearest walker beside it moving alike (the predictions still agree).
       double best = params_.companion_max_gap_m;
@@ -223,7 +222,6 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
     s.x.head<2>() = companion.x.head<2>() + s.companion_offset;
     s.x.tail<2>() = companion.x.tail<2>();
     s.P = companion.P;
-    s.following = true;
   }
 }
 
@@ -391,8 +389,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
         }
       } else {
         t.state = TrackState::kLost;
-        const double limit = s.following ? std::max(MaxOcclusion(s), params_.companion_max_occlusion_s) : MaxOcclusion(s);
-        if (stamp_s - t.last_seen_s > limit) {
+        if (stamp_s - t.last_seen_s > MaxOcclusion(s)) {
           ++deleted_;
           continue;
         }
