@@ -426,6 +426,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     s.track.xy_m = s.x.head<2>();
     s.track.velocity_mps = s.x.tail<2>();
     s.track.position_cov_m2 = s.P.topLeftCorner<2, 2>();
+    s.track.velocity_cov_m2ps2 = s.P.bottomRightCorner<2, 2>();
     snapshot_.push_back(s.track);
   }
   return snapshot_;

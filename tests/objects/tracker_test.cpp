@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <random>
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include "romo/core/check.hpp"
@@ -157,6 +158,38 @@ TEST(TrackerTest, TotalOcclusionKeepsTrackAndReassociates) {
   EXPECT_GE(r.lost_frames, 14);  // coasted through (almost) all 15 hidden frames
   EXPECT_LT(r.score.max_error_m, kMaxErrorM);
   EXPECT_EQ(r.score.misses, 2 * 2);  // only before confirmation
+}
+
+TEST(TrackerTest, VelocityCovarianceShrinksWhileMeasuredAndGrowsWhileCoasting) {
+  const Atlas atlas = LoadAtlas();
+  Tracker tracker(atlas, TrackerParams{});
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, kDetectionNoiseM);
+  const Eigen::Vector2d velocity(1.2, -0.4);
+  auto step = [&](int frame, bool seen) {
+    std::vector<Detection> detections;
+    const Eigen::Vector2d xy = Eigen::Vector2d(2.0, 1.0) + velocity * frame * kFrameS;
+    if (seen) detections.push_back(PedestrianBlob(atlas, xy + Eigen::Vector2d(noise(rng), noise(rng)), 0.3, 0.6, 0.4));
+    const auto& tracks = tracker.Update(frame * kFrameS, detections);
+    EXPECT_EQ(tracks.size(), 1u);
+    return tracks.front();
+  };
+  auto trace = [](const Track& t) { return t.velocity_cov_m2ps2.trace(); };
+  Track t;
+  for (int k = 0; k < 5; ++k) t = step(k, true);
+  const double after_5 = trace(t);
+  for (int k = 5; k < 30; ++k) t = step(k, true);
+  const double after_30 = trace(t);
+  EXPECT_LT(after_30, after_5);
+  // Symmetric, positive definite, and the estimate within 3 sigma of the true velocity (the
+  // Mahalanobis distance of a 2-D Gaussian stays under 11.8 with 99.7 % probability).
+  EXPECT_NEAR((t.velocity_cov_m2ps2 - t.velocity_cov_m2ps2.transpose()).norm(), 0.0, 1e-12);
+  EXPECT_GT(t.velocity_cov_m2ps2.determinant(), 0.0);
+  const Eigen::Vector2d err = t.velocity_mps - velocity;
+  EXPECT_LT(err.dot(t.velocity_cov_m2ps2.inverse() * err), 11.8);
+  for (int k = 30; k < 35; ++k) t = step(k, false);
+  ASSERT_EQ(t.state, TrackState::kLost);
+  EXPECT_GT(trace(t), after_30);
 }
 
 TEST(TrackerTest, OcclusionLongerThanLimitEndsTrack) {

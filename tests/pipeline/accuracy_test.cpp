@@ -188,8 +188,10 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // left unscored (the truth on one side, its box on the other): car P 0.913 -> 0.917, R 0.860 ->
   // 0.863, pedestrian P 0.872 -> 0.873, R 0.749 -> 0.759. Session 26: a pedestrian hidden by
   // the one walking beside it follows that companion (TrackerParams::companion_*): pedestrian
-  // P 0.873 -> 0.902, R 0.759 -> 0.764, car P 0.917 -> 0.912.
-  EXPECT_GE(mean.car_p, 0.90);
+  // P 0.873 -> 0.902, R 0.759 -> 0.764, car P 0.917 -> 0.912. Session 27: coasting cars listed
+  // where last measured, and not where a car is measured now: car P 0.911 -> 0.939, R 0.863 ->
+  // 0.866.
+  EXPECT_GE(mean.car_p, 0.92);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
   EXPECT_GE(mean.ped_p, 0.88);

@@ -54,6 +54,21 @@ Eigen::Vector2d Rotate(const Eigen::Vector2d& v, double yaw) {
   return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
 }
 
+// Whether an obstacle of @p class_name measured now (num_points > 0) has its centre within
+// @p radius_m of @p xy (vehicle frame).
+bool MeasuredWithin(const std::vector<planning_iface::Obstacle>& obstacles, const std::string& class_name,
+                    const Eigen::Vector2d& xy, double radius_m) {
+  return std::any_of(obstacles.begin(), obstacles.end(), [&](const planning_iface::Obstacle& o) {
+    return o.class_name == class_name && o.num_points > 0 && (o.center_m.head<2>() - xy).norm() < radius_m;
+  });
+}
+
+// A covariance turned like Rotate turns its vectors.
+Eigen::Matrix2d RotateCovariance(const Eigen::Matrix2d& cov, double yaw) {
+  const Eigen::Matrix2d r = Eigen::Rotation2Dd(yaw).toRotationMatrix();
+  return r * cov * r.transpose();
+}
+
 // How much depth noise widens a blob's trimmed extent along the line of sight: the trimmed fit
 // keeps the points between the trim and 1 - trim quantiles, +-z sigma_z of a surface seen with
 // Gaussian depth noise (z = 1.88 for 3 %), sigma_z being the blob's median.
@@ -457,12 +472,7 @@ class Pipeline::Impl {
         continue;
       }
       // (by place, not track id: a track that jumped to another car does not show this one)
-      bool seen_now = false;
-      for (const auto& o : r.obstacles.obstacles) {
-        seen_now = seen_now || (o.class_name == car_name && o.num_points > 0 &&
-                                (o.center_m.head<2>() - xy).norm() < 0.5 * d.length_m);
-      }
-      if (!seen_now) hidden.emplace_back(*it);
+      if (!MeasuredWithin(r.obstacles.obstacles, car_name, xy, 0.5 * d.length_m)) hidden.emplace_back(*it);
       ++it;
     }
     return hidden;
@@ -1442,6 +1452,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     planning_iface::Obstacle o = footprint_obstacle(tr.id, tr.class_index, tr.class_score, tr.xy_m, tr.yaw_rad,
                                                     tr.length_m, tr.width_m, tr.height_m);
     o.velocity_mps = Rotate(tr.velocity_mps, -r.ego_world.yaw_rad);
+    o.velocity_cov = RotateCovariance(tr.velocity_cov_m2ps2, -r.ego_world.yaw_rad);
     o.num_points = num_points;
     const auto& cls = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)];
     if (cls.has_priors && s.atlas.Score(tr.class_index, tr.length_m, tr.width_m, tr.height_m) < s.atlas.min_score()) {
@@ -1454,6 +1465,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     }
     return o;
   };
+  std::vector<planning_iface::Obstacle> coasting;
   for (const auto& tr : r.tracks) {
     if (tr.detection_index >= 0 && tr.detection_index < static_cast<int>(r.boxes.size())) {
       track_of[tr.detection_index] = tr.id;
@@ -1468,7 +1480,13 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
       if (tr.velocity_mps.norm() > s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].max_speed_mps) {
         continue;
       }
-      r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
+      // A class without a path model (a car) is listed where it was last measured, not where its
+      // velocity carries it: that velocity is mostly the box's centre moving as the view of the
+      // car changes while the vehicle passes it (parking scene seeds 1-5: 24 of 136 coasting car
+      // boxes carried off the car, none brought onto one). Its velocity still goes out.
+      objects::Track shown = tr;
+      if (!s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].predict_path) shown.xy_m = tr.observed_xy_m;
+      coasting.push_back(track_obstacle(shown, 0));
     }
   }
   for (std::size_t i = 0; i < r.boxes.size(); ++i) {
@@ -1489,10 +1507,20 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     o.num_points = static_cast<int>(r.blobs[i].size());
     if (track_ptr[i] != nullptr) {
       o.velocity_mps = Rotate(track_ptr[i]->velocity_mps, -r.ego_world.yaw_rad);
+      o.velocity_cov = RotateCovariance(track_ptr[i]->velocity_cov_m2ps2, -r.ego_world.yaw_rad);
     }
     r.obstacles.obstacles.push_back(o);
   }
 
+  // A coasting car (no path model) where a car is measured now is that car under another track
+  // (its blob went to a new one): listed once, as measured. People stay: one hidden beside another
+  // is still there.
+  for (const planning_iface::Obstacle& c : coasting) {
+    const int class_index = s.atlas.Find(c.class_name);
+    const bool duplicate = class_index >= 0 && !s.atlas.classes()[static_cast<std::size_t>(class_index)].predict_path &&
+                           MeasuredWithin(r.obstacles.obstacles, c.class_name, c.center_m.head<2>(), 0.5 * c.size_m.x());
+    if (!duplicate) r.obstacles.obstacles.push_back(c);
+  }
   s.RememberParkedCars(r, r.tracks, detections);
   const std::vector<std::pair<int, objects::Detection>> hidden_cars = s.HiddenParkedCars(r);
   for (const auto& [id, d] : hidden_cars) {

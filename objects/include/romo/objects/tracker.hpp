@@ -47,6 +47,7 @@ struct Track {
   Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();   ///< filtered (or coasted) position
   Eigen::Vector2d velocity_mps = Eigen::Vector2d::Zero();
   Eigen::Matrix2d position_cov_m2 = Eigen::Matrix2d::Zero();
+  Eigen::Matrix2d velocity_cov_m2ps2 = Eigen::Matrix2d::Zero();  ///< (m/s)^2
   double yaw_rad = 0.0;           ///< box heading, unwrapped against the track (mod pi)
   double length_m = 0.0, width_m = 0.0, height_m = 0.0;
   double first_seen_s = 0.0;
