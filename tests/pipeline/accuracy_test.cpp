@@ -190,8 +190,8 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // the one walking beside it follows that companion (TrackerParams::companion_*): pedestrian
   // P 0.873 -> 0.902, R 0.759 -> 0.764, car P 0.917 -> 0.912. Session 27: coasting cars listed
   // where last measured, and not where a car is measured now: car P 0.911 -> 0.939, R 0.863 ->
-  // 0.866.
-  EXPECT_GE(mean.car_p, 0.92);
+  // 0.866; then car tracks in a blob of people not listed: car P 0.939 -> 0.945.
+  EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
   EXPECT_GE(mean.ped_p, 0.88);

@@ -733,6 +733,42 @@ TEST(PipelineTest, ACarMeasuredUnderANewTrackIsListedOnceNotAlsoWhereItsOldTrack
   EXPECT_NEAR(cars[0].center_m.y(), 1.9, kBoxCentreTolM);
 }
 
+TEST(PipelineTest, ACarTrackInABlobOfPeopleIsNoCarThere) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  Pipeline pipe(calibration, PipelineParams{});
+  std::int64_t t = 1'000'000'000;
+  // A car 4..8.5 m ahead for 4 frames (a confirmed car track at 6.25 m), then gone; a person
+  // walking at 1.2 m/s toward where it stood from 3.6 m to its left, joined from frame 4 by a
+  // second one beside them (one blob of two people, which the car's coasting track takes a share
+  // of in frames 6 and 7).
+  const int car = pipe.atlas().Find("car");
+  int car_in_blob_frames = 0;
+  for (int k = 0; k < 8; ++k) {
+    RigInput in = SyntheticRig(k < 4 ? 0 : 1, t);
+    in.rig_id = 0;
+    const float y = 3.6f - 0.36f * static_cast<float>(k);
+    AddColumn(&in.cloud, {6.25f, y}, 1.7f);
+    if (k >= 4) AddColumn(&in.cloud, {6.25f, y + 0.45f}, 1.7f);
+    const FrameResult r = pipe.ProcessClouds(t, k, {in}, std::nullopt, std::nullopt);
+    t += 300'000'000;
+    const bool car_in_blob = std::any_of(r.tracks.begin(), r.tracks.end(), [&](const objects::Track& tr) {
+      return tr.class_index == car && tr.merged;
+    });
+    if (!car_in_blob) continue;
+    ++car_in_blob_frames;
+    int pedestrians = 0;
+    for (const auto& o : r.obstacles.obstacles) {
+      EXPECT_NE(o.class_name, "car") << "frame " << k;
+      if (o.class_name == "pedestrian") {
+        ++pedestrians;
+        EXPECT_NEAR(o.center_m.y(), y + 0.225, 0.5) << "frame " << k;  // within the blob
+      }
+    }
+    EXPECT_EQ(pedestrians, 1) << "frame " << k;  // the one tracked; the other is new
+  }
+  ASSERT_GE(car_in_blob_frames, 1) << "the test needs a car track sharing the people's blob";
+}
+
 TEST(PipelineTest, APersonBrokenAtTheWaistIsMergedIntoOnePedestrian) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   auto classes = [](const FrameResult& r) {

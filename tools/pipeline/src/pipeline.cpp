@@ -1491,9 +1491,14 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   }
   for (std::size_t i = 0; i < r.boxes.size(); ++i) {
     if (merged_tracks[i].size() > 1) {
+      // A blob is shared only by people side by side (objects::TrackerParams::max_tracks_per_blob):
+      // a track of a class without a path model among them (a car voted on earlier views) is not
+      // one of the objects there.
       const int share = static_cast<int>(r.blobs[i].size() / merged_tracks[i].size());
       for (const objects::Track* tr : merged_tracks[i]) {
-        if (tr->class_index >= 0) r.obstacles.obstacles.push_back(track_obstacle(*tr, share));
+        if (tr->class_index >= 0 && s.atlas.classes()[static_cast<std::size_t>(tr->class_index)].predict_path) {
+          r.obstacles.obstacles.push_back(track_obstacle(*tr, share));
+        }
       }
       continue;
     }
