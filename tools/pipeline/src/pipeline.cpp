@@ -1465,7 +1465,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     }
     return o;
   };
-  std::vector<planning_iface::Obstacle> coasting;
+  std::vector<planning_iface::Obstacle> coasting_cars;  // listed once the measured boxes are
   for (const auto& tr : r.tracks) {
     if (tr.detection_index >= 0 && tr.detection_index < static_cast<int>(r.boxes.size())) {
       track_of[tr.detection_index] = tr.id;
@@ -1477,7 +1477,10 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
       // A track coasting faster than its class moves (Atlas max_speed_mps) took its velocity from
       // jumps between unrelated blobs (car-end pieces read as a person): where it coasts to means
       // nothing.
-      if (tr.velocity_mps.norm() > s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].max_speed_mps) {
+      const objects::ObjectClass& cls = s.atlas.classes()[static_cast<std::size_t>(tr.class_index)];
+      if (tr.velocity_mps.norm() > cls.max_speed_mps) continue;
+      if (cls.predict_path) {
+        r.obstacles.obstacles.push_back(track_obstacle(tr, 0));
         continue;
       }
       // A class without a path model (a car) is listed where it was last measured, not where its
@@ -1485,8 +1488,8 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
       // car changes while the vehicle passes it (parking scene seeds 1-5: 24 of 136 coasting car
       // boxes carried off the car, none brought onto one). Its velocity still goes out.
       objects::Track shown = tr;
-      if (!s.atlas.classes()[static_cast<std::size_t>(tr.class_index)].predict_path) shown.xy_m = tr.observed_xy_m;
-      coasting.push_back(track_obstacle(shown, 0));
+      shown.xy_m = tr.observed_xy_m;
+      coasting_cars.push_back(track_obstacle(shown, 0));
     }
   }
   for (std::size_t i = 0; i < r.boxes.size(); ++i) {
@@ -1517,14 +1520,13 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     r.obstacles.obstacles.push_back(o);
   }
 
-  // A coasting car (no path model) where a car is measured now is that car under another track
-  // (its blob went to a new one): listed once, as measured. People stay: one hidden beside another
-  // is still there.
-  for (const planning_iface::Obstacle& c : coasting) {
-    const int class_index = s.atlas.Find(c.class_name);
-    const bool duplicate = class_index >= 0 && !s.atlas.classes()[static_cast<std::size_t>(class_index)].predict_path &&
-                           MeasuredWithin(r.obstacles.obstacles, c.class_name, c.center_m.head<2>(), 0.5 * c.size_m.x());
-    if (!duplicate) r.obstacles.obstacles.push_back(c);
+  // A coasting car where a car is measured now is that car under another track (its blob went to
+  // a new one): listed once, as measured. (People coasting stay: one hidden beside another is
+  // still there.)
+  for (const planning_iface::Obstacle& c : coasting_cars) {
+    if (!MeasuredWithin(r.obstacles.obstacles, c.class_name, c.center_m.head<2>(), 0.5 * c.size_m.x())) {
+      r.obstacles.obstacles.push_back(c);
+    }
   }
   s.RememberParkedCars(r, r.tracks, detections);
   const std::vector<std::pair<int, objects::Detection>> hidden_cars = s.HiddenParkedCars(r);
