@@ -29,6 +29,7 @@ struct Options {
   int min_points = 10;
   float max_extent_m = 8.f;
   float ground_tolerance_m = 0.1f;
+  float ground_contact_m = 0.25f;  // as romo run (PipelineParams::ground_contact_gap_m)
   bool json = false;
   std::string out_dir;
   std::string atlas;  // "" = objects::Atlas::DefaultPath()
@@ -105,6 +106,9 @@ void Run(const Options& o) {
   mapping::GroundRemovalParams gp;
   gp.height_tolerance_m = o.ground_tolerance_m;
   gp.Validate();
+  if (!(o.ground_contact_m >= 0.f) || !std::isfinite(o.ground_contact_m)) {
+    Fail("--ground-contact must be a finite height >= 0 m, got " + std::to_string(o.ground_contact_m));
+  }
   const objects::Atlas atlas = objects::Atlas::Load(o.atlas.empty() ? objects::Atlas::DefaultPath() : o.atlas);
 
   stereo::PcdLoadStats load_stats;
@@ -116,7 +120,8 @@ void Run(const Options& o) {
   for (const auto& indices : s.blobs) {
     BlobReport r;
     r.indices = indices;
-    r.box = objects::FitVerticalBox(cloud.xyz, indices, ground.plane.normal);
+    r.box = objects::StandOnGround(objects::FitVerticalBox(cloud.xyz, indices, ground.plane.normal), ground.plane,
+                                   o.ground_contact_m);
     r.cls = ClassifyBlob(atlas, r.box);
     blobs.push_back(std::move(r));
   }
@@ -179,6 +184,10 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--ground-tolerance", opts->ground_tolerance_m,
                   "points up to this height above the ground plane are removed, metres")
+      ->capture_default_str();
+  cmd->add_option("--ground-contact", opts->ground_contact_m,
+                  "blobs whose bottom is at most this far above the ground plane reach down to it (ground "
+                  "removal took their lowest points with the ground), metres; 0 = as measured")
       ->capture_default_str();
   cmd->add_option("--atlas", opts->atlas,
                   "Atlas YAML with the classes' size priors (default config/atlas.yaml or $ROMO_ATLAS)");

@@ -344,6 +344,19 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
   return FitVertical(xyz, indices, up, hint_yaw_rad, trim_fraction, std::nullopt, criterion);
 }
 
+Box3 StandOnGround(Box3 box, const mapping::Plane& ground, float max_gap_m) {
+  if (!(max_gap_m >= 0.f) || !std::isfinite(max_gap_m)) {
+    Fail("StandOnGround: max_gap_m must be finite and >= 0, got " + std::to_string(max_gap_m));
+  }
+  const Eigen::Vector3f up = ground.normal.normalized();
+  const float bottom = ground.SignedDistance(box.center - up * (0.5f * box.size.z()));
+  if (bottom > 0.f && bottom <= max_gap_m) {
+    box.center -= up * (0.5f * bottom);
+    box.size.z() += bottom;
+  }
+  return box;
+}
+
 Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
                              float yaw_rad, float trim_fraction) {
   if (!std::isfinite(yaw_rad)) Fail("FitVerticalBoxAtHeading: yaw_rad must be finite, got " + std::to_string(yaw_rad));

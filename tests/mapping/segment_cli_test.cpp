@@ -148,10 +148,10 @@ TEST(SegmentCliTest, JsonBoxesAndAtlasClassesOfACarAndAPedestrian) {
     const auto points = blob["points"].as<std::size_t>();
     EXPECT_GE(points, sure) << kClasses[o];
     EXPECT_LE(points, maybe) << kClasses[o];
-    // The box spans what is left above the cut: from 0.1 m up to the top.
-    const float height = obj.size.z() - static_cast<float>(kGroundToleranceM);
-    const Eigen::Vector3f centre(obj.center_xy.x(), obj.center_xy.y(),
-                                 static_cast<float>(kGroundToleranceM) + 0.5f * height);
+    // The blob is what is left above the cut, its box stood back on the ground (--ground-contact
+    // 0.25 m: the cut is 0.1 m): from the plane up to the top.
+    const float height = obj.size.z();
+    const Eigen::Vector3f centre(obj.center_xy.x(), obj.center_xy.y(), 0.5f * height);
     const Eigen::Vector3f got_centre(blob["center"][0].as<float>(), blob["center"][1].as<float>(),
                                      blob["center"][2].as<float>());
     EXPECT_LT((got_centre - centre).norm(), kCentreToleranceM) << kClasses[o] << " " << got_centre.transpose();
@@ -165,6 +165,17 @@ TEST(SegmentCliTest, JsonBoxesAndAtlasClassesOfACarAndAPedestrian) {
     const float yaw = blob["yaw"].as<float>();
     EXPECT_LT(std::abs(std::remainder(yaw - obj.yaw_rad, 3.14159265f)), kYawTolerances[o]) << kClasses[o] << " " << yaw;
     EXPECT_EQ(blob["class"].as<std::string>(), kClasses[o]);
+  }
+
+  // --ground-contact 0: the boxes as measured, from the cut up.
+  const auto measured = Romo("segment --pcd " + dir / "scene.pcd" + " --json --ground-contact 0");
+  ASSERT_EQ(measured.exit_code, 0) << measured.err;
+  const YAML::Node measured_blobs = YAML::Load(measured.out)["blobs"];
+  ASSERT_EQ(measured_blobs.size(), objects.size());
+  for (std::size_t b = 0; b < measured_blobs.size(); ++b) {
+    const float cut_height = blobs[b]["size"][2].as<float>() - static_cast<float>(kGroundToleranceM);
+    EXPECT_NEAR(measured_blobs[b]["size"][2].as<float>(), cut_height, kMaxExtentGrowthM) << measured.out;
+    EXPECT_EQ(measured_blobs[b]["points"].as<std::size_t>(), blobs[b]["points"].as<std::size_t>());
   }
 
   // --atlas: a file that is not there is named.
@@ -184,6 +195,9 @@ TEST(SegmentCliTest, BadInputExitsWithAClearError) {
   const auto leaf = Romo("segment --pcd " + dir / "one.pcd" + " --leaf 0");
   EXPECT_EQ(leaf.exit_code, 2);
   EXPECT_NE(leaf.err.find("leaf_size_m"), std::string::npos) << leaf.err;
+  const auto contact = Romo("segment --pcd " + dir / "one.pcd" + " --ground-contact -0.2");
+  EXPECT_EQ(contact.exit_code, 2);
+  EXPECT_NE(contact.err.find("--ground-contact"), std::string::npos) << contact.err;
   const auto single = Romo("segment --pcd " + dir / "one.pcd" + " --json --min-points 1");
   ASSERT_EQ(single.exit_code, 0) << single.err;
   EXPECT_NE(single.out.find("\"points\": 1,"), std::string::npos) << single.out;

@@ -8,6 +8,7 @@
 
 #include "romo/core/angles.hpp"
 #include "romo/core/check.hpp"
+#include "romo/mapping/ground_removal.hpp"
 #include "romo/mapping/segmentation.hpp"
 #include "romo/mapping/synthetic_scene.hpp"
 #include "romo/objects/box.hpp"
@@ -347,6 +348,50 @@ TEST(BoxFitTest, EdgeClosenessFindsTheHeadingOfANoisyCornerView) {
   // smallest rectangle is 42 degrees off on average, nearly the worst a quarter-turn can be.
   EXPECT_LT(worst_closeness, 7.0);
   EXPECT_GT(mean_area, 20.0) << "the smallest rectangle is not misled here";
+}
+
+// Ground removal takes a person's lowest centimetres with the ground; standing the box on the
+// fitted plane gives the person's height back. Things floating higher (a torso whose legs stereo
+// lost, an overhang) keep their measured box.
+TEST(BoxFitTest, ABoxCutByGroundRemovalStandsOnTheGroundAgain) {
+  mapping::SceneObject person;
+  person.shape = mapping::SceneObject::Shape::kCylinder;
+  person.center_xy = {5.f, 2.f};
+  person.size = {0.5f, 0.5f, 1.75f};
+  mapping::SyntheticSceneParams sp;
+  sp.density_per_m2 = 2000.f;
+  sp.ground_half_extent_m = 8.f;
+  sp.ground_height_m = -0.4f;  // the ground below the vehicle frame's origin: heights are the plane's
+  const mapping::SyntheticScene scene = mapping::MakeSyntheticScene({person}, sp);
+  mapping::GroundRemovalParams gp;
+  gp.prior_height_m = -0.4f;
+  const mapping::GroundRemoval ground = mapping::RemoveGround(scene.cloud, gp);
+  ASSERT_TRUE(ground.refined);
+  std::vector<int> person_points, torso_points;  // the torso: what is left when stereo loses the legs
+  for (int i : ground.obstacles) {
+    if (scene.labels[static_cast<std::size_t>(i)] != 0) continue;
+    person_points.push_back(i);
+    if (ground.plane.SignedDistance(scene.cloud.xyz.col(i)) > 0.9f) torso_points.push_back(i);
+  }
+  const Box3 measured = FitVerticalBox(scene.cloud.xyz, person_points, ground.plane.normal);
+  // The removal's tolerance is gone from the bottom (0.1 m, give or take the sampling).
+  EXPECT_NEAR(measured.size.z(), 1.75f - gp.height_tolerance_m, kSizeToleranceM);
+  const Box3 standing = StandOnGround(measured, ground.plane, 0.25f);
+  EXPECT_NEAR(standing.size.z(), 1.75f, kSizeToleranceM);
+  EXPECT_NEAR(standing.center.z(), -0.4f + 0.5f * 1.75f, kCentreToleranceM);
+  EXPECT_TRUE(standing.center.head<2>().isApprox(measured.center.head<2>()));
+  EXPECT_EQ(standing.size.head<2>(), measured.size.head<2>());
+  EXPECT_EQ(StandOnGround(measured, ground.plane, 0.f).size, measured.size);  // 0 = as measured
+  EXPECT_EQ(StandOnGround(measured, ground.plane, 0.05f).size, measured.size);  // floats higher than that
+  const Box3 torso = FitVerticalBox(scene.cloud.xyz, torso_points, ground.plane.normal);
+  EXPECT_EQ(StandOnGround(torso, ground.plane, 0.25f).size, torso.size);
+  EXPECT_NEAR(StandOnGround(torso, ground.plane, 1.f).size.z(), 1.75f, kSizeToleranceM);
+  // A box reaching below the plane is left as it is.
+  Box3 sunk = standing;
+  sunk.center.z() -= 0.1f;
+  EXPECT_EQ(StandOnGround(sunk, ground.plane, 0.25f).center, sunk.center);
+  EXPECT_THROW(StandOnGround(measured, ground.plane, -0.1f), romo::Error);
+  EXPECT_THROW(StandOnGround(measured, ground.plane, std::nanf("")), romo::Error);
 }
 
 TEST(BoxFitTest, BadInputIsRejected) {

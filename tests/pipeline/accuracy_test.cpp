@@ -190,30 +190,35 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // the one walking beside it follows that companion (TrackerParams::companion_*): pedestrian
   // P 0.873 -> 0.902, R 0.759 -> 0.764, car P 0.917 -> 0.912. Session 27: coasting cars listed
   // where last measured, and not where a car is measured now: car P 0.911 -> 0.939, R 0.863 ->
-  // 0.866; then car tracks in a blob of people not listed: car P 0.939 -> 0.945.
+  // 0.866; then car tracks in a blob of people not listed: car P 0.939 -> 0.945. Session 28:
+  // boxes stand on the ground (ground_contact_gap_m) and the Atlas's walkers and riders are 1.5 m
+  // tall and up: pedestrian P 0.904 -> 0.889, R 0.764 -> 0.813 (visible 0.819 -> 0.865, hidden
+  // 0.39 -> 0.45), car P 0.945 -> 0.950, R 0.866 -> 0.859 (hidden 0.785 -> 0.731: memories half a
+  // bay off), centre 0.262 -> 0.274 m (the people now found are the harder ones).
   EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
-  EXPECT_GE(mean.ped_p, 0.88);
-  EXPECT_GE(mean.ped_r, 0.74);
-  EXPECT_GE(mean.ped_visible_r, 0.80);
-  EXPECT_LE(mean.centre_m, 0.275);
+  EXPECT_GE(mean.ped_p, 0.87);
+  EXPECT_GE(mean.ped_r, 0.79);
+  EXPECT_GE(mean.ped_visible_r, 0.84);
+  EXPECT_LE(mean.centre_m, 0.285);
   EXPECT_LE(mean.car_yaw_deg, 2.5);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
   // Session 19: of the sightings hidden now the memory finds cars 0.30 and pedestrians 0.38 (mean
   // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
   // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
-  EXPECT_GE(mean.car_hidden_r, 0.72);  // 0.33 since session 20, 0.47 since 22, 0.76 since 25
-  EXPECT_GE(mean.ped_hidden_r, 0.30);
+  EXPECT_GE(mean.car_hidden_r, 0.70);  // 0.33 since session 20, 0.47 since 22, 0.76 since 25, 0.73 since 28
+  EXPECT_GE(mean.ped_hidden_r, 0.40);
 }
 
 // The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo
 // work), seed 1 only to keep CI short. Here more of the targets are met, and asserted:
-// car precision >= 0.95, box centre within 0.2 m, the bay found in every frame it is fully
-// visible; the others are floors a little under seed 1's figures (car P 0.986 R 0.934, pedestrian
-// P 0.955 R 0.760, centre 0.188 m, slot 32/32 at 0.053 m; car recall was 0.665 before parked
-// cars were placed by their row's paint, session 25).
+// car and pedestrian precision >= 0.95, box centre within 0.2 m, the bay found in every frame it
+// is fully visible; the others are floors a little under seed 1's figures (car P 0.983 R 0.947,
+// pedestrian P 0.982 R 0.857, centre 0.185 m, slot 32/32 at 0.056 m; car recall was 0.665 before
+// parked cars were placed by their row's paint, session 25; pedestrians 0.955 / 0.760 before boxes
+// stood on the ground, session 28).
 TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   romo::test::ScratchDir dir;
   const auto run = romo::test::RunRomo("run --no-pictures --scale 1 --seed 1 --out " + dir.path());
@@ -228,8 +233,8 @@ TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   EXPECT_LE(e.box_center_err_m_median, 0.2);
   EXPECT_GE(e.car.precision(), 0.95);
   EXPECT_GE(e.car.recall(), 0.92);
-  EXPECT_GE(e.pedestrian.precision(), 0.9);
-  EXPECT_GE(e.pedestrian.recall(), 0.70);
+  EXPECT_GE(e.pedestrian.precision(), 0.95);
+  EXPECT_GE(e.pedestrian.recall(), 0.82);
 }
 
 }  // namespace

@@ -411,6 +411,33 @@ RigInput PeopleAhead(const std::vector<float>& xs, float gap_lo_m = 0.f, float g
   return in;
 }
 
+// Ground removal takes a person's lowest 0.1 m with the ground: their box stands on the ground
+// again (ground_contact_gap_m), as tall as they are, and a person of 1.6 m (the Atlas's walkers
+// are 1.5 m and up) is a pedestrian, not a blob of no class 1.4 m tall floating above the ground.
+TEST(PipelineTest, APersonIsBoxedFromTheGroundAtTheirHeight) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto person = [&](const PipelineParams& params) {
+    RigInput in = SyntheticRig(1, 1000);  // ground only
+    in.rig_id = 0;
+    AddColumn(&in.cloud, {5.f, 0.f}, 1.6f);
+    const FrameResult r = Pipeline(calibration, params).ProcessClouds(1000, 1, {in}, std::nullopt, std::nullopt);
+    EXPECT_EQ(r.obstacles.obstacles.size(), 1u);
+    return r.obstacles.obstacles.empty() ? planning_iface::Obstacle{} : r.obstacles.obstacles.front();
+  };
+  // The column's top sample is at 1.57 m; the box fit trims 3 % of the points at each end.
+  constexpr double kHeightTolM = 0.08;
+  const planning_iface::Obstacle standing = person(PipelineParams{});
+  EXPECT_EQ(standing.class_name, "pedestrian");
+  EXPECT_NEAR(standing.size_m.z(), 1.6, kHeightTolM);
+  EXPECT_NEAR(standing.center_m.z() - 0.5 * standing.size_m.z(), 0.0, 0.01);  // on the ground
+  PipelineParams as_measured;
+  as_measured.ground_contact_gap_m = 0.0;
+  const planning_iface::Obstacle floating = person(as_measured);
+  EXPECT_EQ(floating.class_name, "unknown");
+  EXPECT_GE(floating.center_m.z() - 0.5 * floating.size_m.z(), 0.1);
+  EXPECT_LT(floating.size_m.z(), standing.size_m.z() - 0.1);
+}
+
 TEST(PipelineTest, APersonSizedPieceInsideAHiddenParkedCarIsNoPedestrian) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   // The car 4..8.5 m ahead seen for 4 frames, then not as a car: what stereo keeps of it is a
@@ -986,6 +1013,7 @@ TEST(PipelineTest, OutOfRangeParamsAreAClearError) {
   rejects(params.bay_face_min_spread_m, {-0.6});
   rejects(params.bay_face_score, {0.0, 1.5});
   rejects(params.bay_row.contrast, {1.0});
+  rejects(params.ground_contact_gap_m, {-0.25, std::nan(""), INFINITY});
   EXPECT_NO_THROW(params.Validate());
   params.parked_free_ground_points = -1;
   EXPECT_THROW(params.Validate(), romo::Error);

@@ -313,6 +313,9 @@ void PipelineParams::Validate() const {
          std::to_string(row_align_free_ground_margin_m) + " m >= 0, points " +
          std::to_string(row_align_free_ground_points) + " >= 1)");
   }
+  if (!(ground_contact_gap_m >= 0) || !std::isfinite(ground_contact_gap_m)) {
+    Fail("pipeline: ground_contact_gap_m must be finite and >= 0, got " + std::to_string(ground_contact_gap_m));
+  }
   if (!(max_ground_gap_m >= 0)) {
     Fail("pipeline: max_ground_gap_m must be >= 0, got " + std::to_string(max_ground_gap_m));
   }
@@ -622,6 +625,7 @@ class Pipeline::Impl {
     return lower_bottom <= params.max_ground_gap_m && upper_bottom > params.max_ground_gap_m &&
            upper_bottom - (lower_bottom + lower_height) <= params.stacked_merge_gap_m;
   }
+  float contact_gap() const { return static_cast<float>(params.ground_contact_gap_m); }
   // How far the bottom of @p box is above the ground plane.
   static float BottomHeight(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& box) {
     return r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
@@ -678,7 +682,7 @@ class Pipeline::Impl {
           if (!may_merge(i, j)) continue;
           std::vector<int> blob = r.blobs[i];
           blob.insert(blob.end(), r.blobs[j].begin(), r.blobs[j].end());
-          const objects::Box3 box = FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]);
+          const objects::Box3 box = objects::StandOnGround(FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]), r.ground_plane, contact_gap());
           Seen union_seen = See(r, box, blob, up, (*viewers)[i]);
           if (!union_seen.on_ground || !union_is_one(box, union_seen)) continue;
           r.boxes[i] = box;
@@ -1068,7 +1072,7 @@ class Pipeline::Impl {
     objects::Box3 boxes[2];
     Seen views[2];
     for (int h = 0; h < 2; ++h) {
-      boxes[h] = FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]);
+      boxes[h] = objects::StandOnGround(FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]), r.ground_plane, contact_gap());
       views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
       if (views[h].viewed.classification.class_index != class_index) return false;
     }
@@ -1317,8 +1321,8 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     if (auto h = s.tracker.YawHint(c_world)) hint = static_cast<float>(*h - r.ego_world.yaw_rad);
     const Eigen::Vector2f viewer = BlobViewer(blob, point_rig_ids, s.calibration);
     const objects::Box3 box = s.FitBox(r.cloud, blob, up, hint, viewer);
-    if (box.size.z() < s.params.min_object_height_m) continue;
-    r.boxes.push_back(box);
+    if (box.size.z() < s.params.min_object_height_m) continue;  // as measured: kerbs stay out
+    r.boxes.push_back(objects::StandOnGround(box, r.ground_plane, s.contact_gap()));
     r.blobs.push_back(std::move(blob));
     viewers.push_back(viewer);
   }

@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 
+#include "romo/mapping/plane_ransac.hpp"
+
 namespace romo::objects {
 
 struct Box3 {
@@ -75,6 +77,14 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
 /// @throws romo::Error as FitVerticalBox, or for a non-finite @p yaw_rad.
 Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
                              float yaw_rad, float trim_fraction = 0.f);
+
+/// @p box (a vertical cuboid, height along @p ground's normal) reaching down to @p ground when its
+/// bottom lies above it by at most @p max_gap_m: ground removal takes the lowest centimetres of
+/// whatever stands on the ground along with the ground, so a car's or person's measured box floats
+/// that far above it and comes out as much too short for its class. Boxes floating higher, or
+/// reaching below the plane, are returned as they are.
+/// @throws romo::Error for a negative or non-finite @p max_gap_m.
+Box3 StandOnGround(Box3 box, const mapping::Plane& ground, float max_gap_m);
 
 /// Heading (about z, in the xy plane) of points @p indices seen by stereo from @p viewer_xy, with
 /// the depth noise taken out of their footprint's second moments: the points' covariance less
