@@ -344,14 +344,17 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
   return FitVertical(xyz, indices, up, hint_yaw_rad, trim_fraction, std::nullopt, criterion);
 }
 
+float HeightAboveGround(const Box3& box, const mapping::Plane& ground) {
+  return ground.SignedDistance(box.center - ground.normal.normalized() * (0.5f * box.size.z()));
+}
+
 Box3 StandOnGround(Box3 box, const mapping::Plane& ground, float max_gap_m) {
   if (!(max_gap_m >= 0.f) || !std::isfinite(max_gap_m)) {
     Fail("StandOnGround: max_gap_m must be finite and >= 0, got " + std::to_string(max_gap_m));
   }
-  const Eigen::Vector3f up = ground.normal.normalized();
-  const float bottom = ground.SignedDistance(box.center - up * (0.5f * box.size.z()));
+  const float bottom = HeightAboveGround(box, ground);
   if (bottom > 0.f && bottom <= max_gap_m) {
-    box.center -= up * (0.5f * bottom);
+    box.center -= ground.normal.normalized() * (0.5f * bottom);
     box.size.z() += bottom;
   }
   return box;

@@ -541,12 +541,12 @@ class Pipeline::Impl {
     bool framed = false;  // cut off by nearer objects at both ends: its extents are no evidence
     bool part_of_parked_car = false;  // a piece of a remembered parked car hidden now
   };
-  Seen See(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob, const Eigen::Vector3f& up,
+  Seen See(const FrameResult& r, const objects::Box3& box, const std::vector<int>& blob,
            const Eigen::Vector2f& viewer) const {
     Seen seen;
     seen.viewed.box = box;
     seen.viewed.classification = {atlas.unknown_index(), 1.0};
-    seen.on_ground = BottomHeight(r, up, box) <= params.max_ground_gap_m;
+    seen.on_ground = objects::HeightAboveGround(box, r.ground_plane) <= params.max_ground_gap_m;
     if (!seen.on_ground) return seen;
     seen.depth_spread_m = DepthSpread(r.cloud.sigma_z_m, blob, params.box_trim_fraction);
     seen.viewed = objects::ClassifyFromViewpoint(atlas, box, viewer, params.completion, seen.depth_spread_m);
@@ -603,7 +603,7 @@ class Pipeline::Impl {
   std::optional<objects::Box3> PartlySeenPerson(const FrameResult& r, const Eigen::Vector3f& up,
                                                 const objects::Box3& box) const {
     const objects::ObjectClass& person = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
-    const float bottom = BottomHeight(r, up, box);
+    const float bottom = objects::HeightAboveGround(box, r.ground_plane);
     const float top = bottom + box.size.z();
     if (!person.length.Contains(box.size.x()) || box.size.y() > person.width.max_m || top > person.height.max_m ||
         !(top > 0.f)) {
@@ -617,18 +617,23 @@ class Pipeline::Impl {
 
   // Whether one of @p a, @p b stands on the ground and the other floats above it, less than
   // PipelineParams::stacked_merge_gap_m over it (legs and a torso).
-  bool Stacked(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& a, const objects::Box3& b) const {
-    const float bottom_a = BottomHeight(r, up, a), bottom_b = BottomHeight(r, up, b);
+  bool Stacked(const FrameResult& r, const objects::Box3& a, const objects::Box3& b) const {
+    const float bottom_a = objects::HeightAboveGround(a, r.ground_plane);
+    const float bottom_b = objects::HeightAboveGround(b, r.ground_plane);
     const bool a_lower = bottom_a <= bottom_b;
     const float lower_bottom = a_lower ? bottom_a : bottom_b, upper_bottom = a_lower ? bottom_b : bottom_a;
     const float lower_height = (a_lower ? a : b).size.z();
     return lower_bottom <= params.max_ground_gap_m && upper_bottom > params.max_ground_gap_m &&
            upper_bottom - (lower_bottom + lower_height) <= params.stacked_merge_gap_m;
   }
-  float contact_gap() const { return static_cast<float>(params.ground_contact_gap_m); }
-  // How far the bottom of @p box is above the ground plane.
-  static float BottomHeight(const FrameResult& r, const Eigen::Vector3f& up, const objects::Box3& box) {
-    return r.ground_plane.SignedDistance(box.center - up * (0.5f * box.size.z()));
+  // @p box reaching down to the ground when it floats just above it (ground_contact_gap_m).
+  objects::Box3 OnGround(const FrameResult& r, const objects::Box3& box) const {
+    return objects::StandOnGround(box, r.ground_plane, static_cast<float>(params.ground_contact_gap_m));
+  }
+  // The box of @p blob, standing on the ground, seen from @p viewer.
+  objects::Box3 FitStandingBox(const FrameResult& r, const std::vector<int>& blob, const Eigen::Vector3f& up,
+                               const Eigen::Vector2f& viewer) const {
+    return OnGround(r, FitBox(r.cloud, blob, up, std::nullopt, viewer));
   }
   bool OfNoClass(const Seen& seen) const { return seen.viewed.classification.class_index == atlas.unknown_index(); }
   bool Unclassified(const Seen& seen) const { return seen.on_ground && OfNoClass(seen); }
@@ -658,7 +663,7 @@ class Pipeline::Impl {
       MergePairs(r, up, viewers, seen, [&](std::size_t i, std::size_t j) {
         return OfNoClass((*seen)[i]) && OfNoClass((*seen)[j]) &&
                (r.boxes[i].center.head<2>() - r.boxes[j].center.head<2>()).norm() <= params.stacked_merge_xy_m &&
-               Stacked(r, up, r.boxes[i], r.boxes[j]);
+               Stacked(r, r.boxes[i], r.boxes[j]);
       }, [&](const objects::Box3& box, const Seen& u) {
         // Pieces of no class joined are a guess: the stack must stand the class's typical height
         // (within a sigma of its mean; height is a person's steady extent).
@@ -682,8 +687,8 @@ class Pipeline::Impl {
           if (!may_merge(i, j)) continue;
           std::vector<int> blob = r.blobs[i];
           blob.insert(blob.end(), r.blobs[j].begin(), r.blobs[j].end());
-          const objects::Box3 box = objects::StandOnGround(FitBox(r.cloud, blob, up, std::nullopt, (*viewers)[i]), r.ground_plane, contact_gap());
-          Seen union_seen = See(r, box, blob, up, (*viewers)[i]);
+          const objects::Box3 box = FitStandingBox(r, blob, up, (*viewers)[i]);
+          Seen union_seen = See(r, box, blob, (*viewers)[i]);
           if (!union_seen.on_ground || !union_is_one(box, union_seen)) continue;
           r.boxes[i] = box;
           r.blobs[i] = std::move(blob);
@@ -1072,8 +1077,8 @@ class Pipeline::Impl {
     objects::Box3 boxes[2];
     Seen views[2];
     for (int h = 0; h < 2; ++h) {
-      boxes[h] = objects::StandOnGround(FitBox(r.cloud, parts[h], up, std::nullopt, (*viewers)[i]), r.ground_plane, contact_gap());
-      views[h] = See(r, boxes[h], parts[h], up, (*viewers)[i]);
+      boxes[h] = FitStandingBox(r, parts[h], up, (*viewers)[i]);
+      views[h] = See(r, boxes[h], parts[h], (*viewers)[i]);
       if (views[h].viewed.classification.class_index != class_index) return false;
     }
     r.boxes[i] = boxes[0];
@@ -1322,7 +1327,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
     const Eigen::Vector2f viewer = BlobViewer(blob, point_rig_ids, s.calibration);
     const objects::Box3 box = s.FitBox(r.cloud, blob, up, hint, viewer);
     if (box.size.z() < s.params.min_object_height_m) continue;  // as measured: kerbs stay out
-    r.boxes.push_back(objects::StandOnGround(box, r.ground_plane, s.contact_gap()));
+    r.boxes.push_back(s.OnGround(r, box));
     r.blobs.push_back(std::move(blob));
     viewers.push_back(viewer);
   }
@@ -1333,7 +1338,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   // Cars and pedestrians stand on the ground: a blob floating above it stays of unknown class.
   t0 = Clock::now();
   std::vector<Pipeline::Impl::Seen> seen;
-  for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], up, viewers[i]));
+  for (std::size_t i = 0; i < r.boxes.size(); ++i) seen.push_back(s.See(r, r.boxes[i], r.blobs[i], viewers[i]));
   s.MergeFragments(r, up, &viewers, &seen);
   s.SplitFacePairs(r, up, &viewers, &seen);
   s.SplitTandems(r, up, &viewers, &seen);

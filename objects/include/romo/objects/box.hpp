@@ -78,6 +78,10 @@ Box3 FitVerticalBox(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices
 Box3 FitVerticalBoxAtHeading(const Eigen::Matrix3Xf& xyz, const std::vector<int>& indices, const Eigen::Vector3f& up,
                              float yaw_rad, float trim_fraction = 0.f);
 
+/// How far the bottom of @p box (a vertical cuboid, height along @p ground's normal) lies above
+/// @p ground; negative when it reaches below.
+float HeightAboveGround(const Box3& box, const mapping::Plane& ground);
+
 /// @p box (a vertical cuboid, height along @p ground's normal) reaching down to @p ground when its
 /// bottom lies above it by at most @p max_gap_m: ground removal takes the lowest centimetres of
 /// whatever stands on the ground along with the ground, so a car's or person's measured box floats
