@@ -1,7 +1,8 @@
 // `romo soak LOG --duration S --out DIR`: the vehicle pipeline over a recording played in a loop
-// for a fixed wall time, sampling resident memory (VmRSS) and per-frame latency (wall and CPU) to
-// show they stay flat: least-squares slopes per minute go to soak.json, samples to soak.csv and
-// a plot to soak.png.
+// for a fixed wall time, sampling resident memory (VmRSS), the heap in use (mallinfo2) and
+// per-frame latency (wall and CPU) to show they stay flat: slopes per minute go to soak.json,
+// samples to soak.csv and a plot to soak.png.
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -35,11 +36,13 @@ struct SoakOptions {
   double duration_s = 120.0;
   double warmup_s = 20.0;
   int threads = 2;
+  double leak_kb_per_frame = 0.0;  // kept and never freed: shows the memory fit catches a leak
 };
 
 struct Sample {
   double t_s = 0.0;
   double rss_mb = 0.0;
+  double heap_mb = 0.0;     // bytes malloc has handed out and not had back (all arenas, mmapped chunks)
   double latency_ms = 0.0;  // the pipeline's own end-to-end time for the frame (wall)
   double cpu_ms = 0.0;      // process CPU time spent on the frame (all threads)
   double tracks = 0.0;      // tracks the pipeline holds after the frame (live and coasting)
@@ -87,17 +90,17 @@ TracksPerLoop CompareLoops(const std::vector<Sample>& measured) {
   return result;
 }
 
-// Resident memory at the same point of every whole loop: the lowest and the highest sample of
-// each. Within a loop RSS jumps between levels ~15 MB apart as the allocator maps and unmaps large
-// buffers, so a fit over the raw samples moves with the phase the window ends at (+3.1 MB/min once
-// with first and last samples 0.3 MB apart), and a fit over the peaks with whether the upper level
-// was reached early or late in the run (+4.6 MB/min once, with the last sample 5.6 MB below the
+// Memory at the same point of every whole loop: the lowest and the highest sample of each. Within
+// a loop RSS jumps between levels ~15 MB apart as the allocator maps and unmaps large buffers, so a
+// fit over the raw samples moves with the phase the window ends at (+3.1 MB/min once with first
+// and last samples 0.3 MB apart), and a fit over the peaks with whether the upper level was
+// reached early or late in the run (+4.6 MB/min once, with the last sample 5.6 MB below the
 // first). What a leak keeps is held between frames too: it lifts every loop's floor.
 struct LoopExtremes {
   std::vector<Sample> floors, peaks;  // one per whole loop, at the loop's mean time
 };
 
-LoopExtremes RssPerLoop(const std::vector<Sample>& measured) {
+LoopExtremes PerLoop(const std::vector<Sample>& measured, double Sample::*field) {
   LoopExtremes result;
   if (measured.empty()) return result;
   const std::int64_t first = measured.front().loop + 1, last = measured.back().loop - 1;
@@ -107,11 +110,11 @@ LoopExtremes RssPerLoop(const std::vector<Sample>& measured) {
   }
   for (const auto& [loop, samples] : by_loop) {
     Sample floor, peak;
-    floor.rss_mb = 1e300, peak.rss_mb = -1e300;
+    floor.*field = 1e300, peak.*field = -1e300;
     for (const Sample* s : samples) {
       floor.t_s += s->t_s / static_cast<double>(samples.size());
-      floor.rss_mb = std::min(floor.rss_mb, s->rss_mb);
-      peak.rss_mb = std::max(peak.rss_mb, s->rss_mb);
+      floor.*field = std::min(floor.*field, s->*field);
+      peak.*field = std::max(peak.*field, s->*field);
     }
     peak.t_s = floor.t_s;
     floor.loop = peak.loop = loop;
@@ -129,6 +132,14 @@ double ResidentMb() {
     if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) * 1024.0 / 1e6;
   }
   Fail("soak: /proc/self/status has no VmRSS line");
+}
+
+// What the program holds from malloc, free of the allocator's own keeping: RSS also moves by
+// ~3 MB steps as freed memory is kept or given back (glibc's heaps and trimming), which a slope
+// over 100 s cannot tell from a leak; the heap in use moves only with what is allocated.
+double HeapInUseMb() {
+  const struct mallinfo2 info = mallinfo2();
+  return static_cast<double>(info.uordblks + info.hblkhd) / 1e6;
 }
 
 double ProcessCpuMs() {
@@ -218,6 +229,10 @@ void Soak(const SoakOptions& o) {
   pipeline::LoopedLog looped(reader);
   fs::create_directories(o.out_dir);
 
+  if (!(o.leak_kb_per_frame >= 0.0 && o.leak_kb_per_frame <= 1e5)) {
+    Fail("soak: --leak-kb-per-frame " + std::to_string(o.leak_kb_per_frame) + " must be in [0, 100000]");
+  }
+  std::vector<std::vector<char>> leaked;  // filled with non-zero bytes so its pages are resident
   std::vector<Sample> samples;
   Progress progress("soak", 0);
   const auto start = std::chrono::steady_clock::now();
@@ -226,9 +241,11 @@ void Soak(const SoakOptions& o) {
   run.duration_s = o.duration_s;
   const auto stats = pipeline::RunFrames(
       looped, pipe, sink, run, nullptr, [&](std::int64_t done, const pipeline::FrameResult& r) {
+        if (o.leak_kb_per_frame > 0.0) leaked.emplace_back(static_cast<std::size_t>(1e3 * o.leak_kb_per_frame), '\1');
         Sample s;
         s.t_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         s.rss_mb = ResidentMb();
+        s.heap_mb = HeapInUseMb();
         s.latency_ms = r.status.total_latency_ms;
         const double cpu_now = ProcessCpuMs();
         s.cpu_ms = cpu_now - cpu_before;
@@ -250,13 +267,16 @@ void Soak(const SoakOptions& o) {
     Fail("soak: only " + std::to_string(measured.size()) + " frames after the " + std::to_string(o.warmup_s) +
          " s warm-up: run longer (--duration) or warm up shorter (--warmup)");
   }
-  const LoopExtremes rss_loops = RssPerLoop(measured);
+  const LoopExtremes rss_loops = PerLoop(measured, &Sample::rss_mb);
+  const LoopExtremes heap_loops = PerLoop(measured, &Sample::heap_mb);
   // Fewer than 3 whole loops (a long recording or a slow host) leave only the raw samples.
   const bool loops_fit = rss_loops.peaks.size() >= 3;
   const Fit rss_samples = LeastSquares(measured, &Sample::rss_mb);
   const Fit rss_floor = loops_fit ? LeastSquares(rss_loops.floors, &Sample::rss_mb) : rss_samples;
   const Fit rss_peak = loops_fit ? LeastSquares(rss_loops.peaks, &Sample::rss_mb) : rss_samples;
   const double rss_slope = rss_floor.slope;
+  const Fit heap_samples = LeastSquares(measured, &Sample::heap_mb);
+  const Fit heap_floor = loops_fit ? LeastSquares(heap_loops.floors, &Sample::heap_mb) : heap_samples;
   const Fit latency = LeastSquares(measured, &Sample::latency_ms);
   const Fit cpu = LeastSquares(measured, &Sample::cpu_ms);
   const TracksPerLoop tracks = CompareLoops(measured);
@@ -269,9 +289,9 @@ void Soak(const SoakOptions& o) {
 
   {
     std::ofstream csv(o.out_dir + "/soak.csv");
-    csv << "t_s,rss_mb,latency_ms,cpu_ms,tracks,loop\n";
+    csv << "t_s,rss_mb,heap_mb,latency_ms,cpu_ms,tracks,loop\n";
     for (const auto& s : samples) {
-      csv << s.t_s << ',' << s.rss_mb << ',' << s.latency_ms << ',' << s.cpu_ms << ',' << s.tracks << ',' << s.loop
+      csv << s.t_s << ',' << s.rss_mb << ',' << s.heap_mb << ',' << s.latency_ms << ',' << s.cpu_ms << ',' << s.tracks << ',' << s.loop
           << '\n';
     }
   }
@@ -284,6 +304,8 @@ void Soak(const SoakOptions& o) {
                   "  \"rss_mb\": {\"first\": %.2f, \"last\": %.2f, \"max\": %.2f, \"mean\": %.2f, \"slope_mb_per_min\": %.4f, "
                   "\"floor_slope_mb_per_min\": %.4f, \"peak_slope_mb_per_min\": %.4f, \"sample_slope_mb_per_min\": %.4f, "
                   "\"loops_fitted\": %zu},\n"
+                  "  \"heap_mb\": {\"first\": %.2f, \"last\": %.2f, \"mean\": %.2f, \"floor_slope_mb_per_min\": %.4f, "
+                  "\"sample_slope_mb_per_min\": %.4f},\n"
                   "  \"latency_ms\": {\"mean\": %.2f, \"p50\": %.2f, \"p95\": %.2f, \"slope_ms_per_min\": %.4f},\n"
                   "  \"cpu_ms_per_frame\": {\"mean\": %.2f, \"slope_ms_per_min\": %.4f},\n"
                   "  \"tracks_per_frame\": {\"first_loop\": %.3f, \"last_loop\": %.3f, \"loops_compared\": %lld, "
@@ -292,22 +314,27 @@ void Soak(const SoakOptions& o) {
                   static_cast<long long>(looped.loops()), static_cast<long long>(stats.skipped_out_of_order),
                   measured.front().rss_mb, measured.back().rss_mb,
                   *std::max_element(rss_values.begin(), rss_values.end()), rss_samples.mean, rss_slope, rss_floor.slope,
-                  rss_peak.slope, rss_samples.slope, loops_fit ? rss_loops.peaks.size() : std::size_t{0}, latency.mean,
+                  rss_peak.slope, rss_samples.slope, loops_fit ? rss_loops.peaks.size() : std::size_t{0},
+                  measured.front().heap_mb, measured.back().heap_mb, heap_samples.mean, heap_floor.slope,
+                  heap_samples.slope, latency.mean,
                   Percentile(latencies, 0.5), Percentile(latencies, 0.95), latency.slope, cpu.mean, cpu.slope, tracks.first, tracks.last,
                   static_cast<long long>(tracks.loops_compared), tracks.first_mean, tracks.last_mean,
                   static_cast<long long>(tracks.loops_averaged));
     json << text;
   }
-  cv::Mat plot(3 * 260 + 20, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::Mat plot(4 * 260 + 20, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
   DrawPanel(&plot, cv::Rect(10, 10, 980, 250), samples, &Sample::rss_mb, rss_floor, o.warmup_s,
             loops_fit ? "resident memory (MB), fit of loop floors" : "resident memory (MB)");
-  DrawPanel(&plot, cv::Rect(10, 270, 980, 250), samples, &Sample::latency_ms, latency, o.warmup_s, "frame latency (ms, wall)");
-  DrawPanel(&plot, cv::Rect(10, 530, 980, 250), samples, &Sample::cpu_ms, cpu, o.warmup_s, "CPU per frame (ms)");
+  DrawPanel(&plot, cv::Rect(10, 270, 980, 250), samples, &Sample::heap_mb, heap_floor, o.warmup_s,
+            loops_fit ? "heap in use (MB), fit of loop floors" : "heap in use (MB)");
+  DrawPanel(&plot, cv::Rect(10, 530, 980, 250), samples, &Sample::latency_ms, latency, o.warmup_s, "frame latency (ms, wall)");
+  DrawPanel(&plot, cv::Rect(10, 790, 980, 250), samples, &Sample::cpu_ms, cpu, o.warmup_s, "CPU per frame (ms)");
   cv::imwrite(o.out_dir + "/soak.png", plot);
-  std::printf("soak: %lld frames (%lld loops of %s) in %.1f s; after %.0f s warm-up: RSS %.1f MB, loop floor slope %+.3f MB/min, "
+  std::printf("soak: %lld frames (%lld loops of %s) in %.1f s; after %.0f s warm-up: RSS %.1f MB, loop floor slope %+.3f MB/min, heap %+.3f MB/min, "
               "latency mean %.1f ms slope %+.3f ms/min, CPU %.1f ms/frame slope %+.3f ms/min; %s/soak.{json,csv,png}\n",
               static_cast<long long>(stats.frames), static_cast<long long>(looped.loops()), o.log.c_str(), wall_s,
-              o.warmup_s, rss_samples.mean, rss_slope, latency.mean, latency.slope, cpu.mean, cpu.slope, o.out_dir.c_str());
+              o.warmup_s, rss_samples.mean, rss_slope, heap_floor.slope, latency.mean, latency.slope, cpu.mean, cpu.slope,
+              o.out_dir.c_str());
 }
 
 }  // namespace
@@ -322,6 +349,9 @@ ROMO_REGISTER_COMMAND([](CLI::App& root) {
   cmd->add_option("--warmup", opts->warmup_s, "seconds left out of the fits (caches and pools filling)")
       ->capture_default_str();
   cmd->add_option("--threads", opts->threads, "stereo threads (rigs in parallel)")->capture_default_str();
+  cmd->add_option("--leak-kb-per-frame", opts->leak_kb_per_frame,
+                  "self-check: keep this much memory per frame, never freed, to see the memory slope catch it")
+      ->capture_default_str();
   cmd->callback([opts] { Soak(*opts); });
 });
 

@@ -1,6 +1,6 @@
 // The CI soak: `romo soak` replays a simulated recording in a loop for 2 minutes and fits
-// resident memory and per-frame latency over time; both must stay flat. The 30-minute run is the
-// same command with --duration 1800 (README, Reliability).
+// resident memory, the heap in use and per-frame latency over time; all must stay flat. The
+// 30-minute run is the same command with --duration 1800 (README, Reliability).
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -39,14 +39,17 @@ TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
   EXPECT_EQ(JsonNumber(json, "skipped_out_of_order"), 0.0);
   EXPECT_GE(JsonNumber(json, "frames_measured"), 30.0);
 
-  // Memory: a leak of even one half-resolution rig cloud per frame (~25k points x 16 B = 0.4 MB)
-  // at the ~1 frame/s of a loaded CI machine grows 24 MB/min; allocator pools settling after the
-  // warm-up move RSS by a few MB over the window. 3 MB/min (90 MB over 30 min) separates them.
-  // The slope is fitted through each whole loop's lowest sample, what is held between frames: RSS
-  // jumps between levels ~15 MB apart within a loop, which moved the fit over raw samples to
-  // +3.1 MB/min in a run whose first and last samples differed by 0.3 MB, and the fit over loop
-  // peaks to +4.6 MB/min in one whose last sample lay 5.6 MB below its first (floors +1.2).
-  constexpr double kMaxRssSlopeMbPerMin = 3.0;
+  // Memory, fitted through each whole loop's lowest sample (what is held between frames), twice.
+  // The heap in use (mallinfo2) moves only with what is allocated: +0.15 MB/min here (the run's
+  // summary), while a leak of 2 kB per frame at the ~8 frames/s of CI is ~1 MB/min. RSS moves
+  // by the allocator's keeping too: loop floors sit on levels ~3 MB apart (~176, ~178, ~179 MB,
+  // a whole loop at ~191 now and then), and over 100 s windows of one 5-minute run their fit
+  // ranged -3.1 to +3.2 MB/min with no leak; a leak of one half-resolution rig cloud per frame
+  // (~25k points x 16 B = 0.4 MB) grows it 24 MB/min even at 1 frame/s.
+  const std::size_t heap_at = json.find("\"heap_mb\"");
+  ASSERT_NE(heap_at, std::string::npos) << json;
+  constexpr double kMaxHeapSlopeMbPerMin = 1.0, kMaxRssSlopeMbPerMin = 10.0;
+  EXPECT_LT(JsonNumber(json.substr(heap_at), "floor_slope_mb_per_min"), kMaxHeapSlopeMbPerMin) << json;
   EXPECT_LT(JsonNumber(json, "slope_mb_per_min"), kMaxRssSlopeMbPerMin) << json;
   EXPECT_GE(JsonNumber(json, "loops_fitted"), 3.0) << "too few whole loops for the RSS fit:\n" << json;
   // Every loop replays the same frames, so the tracks held per frame must not grow from the
@@ -83,6 +86,35 @@ TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
       << "CPU per frame and wall latency both rise by more than " << 100.0 * kMaxRiseOfMeanPerMin
       << " % of their mean per minute:\n"
       << json;
+}
+
+// The memory checks catch a leak: `romo soak --leak-kb-per-frame` keeps that much per frame,
+// never freed, and the heap's slope must come out at the leak's rate (frames per minute times
+// the leak; malloc adds 16 B a chunk), RSS's well above the bound the test above applies.
+TEST(SoakTest, AnInjectedLeakShowsInTheMemorySlopes) {
+  test::ScratchDir dir;
+  const auto sim = test::RunRomo("sim --frames 12 --scale 0.5 --out " + dir / "sim.lcmlog");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  constexpr double kDurationS = 40.0, kWarmupS = 10.0, kLeakKb = 200.0;
+  const auto soak = test::RunRomo("soak " + dir / "sim.lcmlog" + " --duration " + std::to_string(kDurationS) +
+                                  " --warmup " + std::to_string(kWarmupS) + " --leak-kb-per-frame " +
+                                  std::to_string(kLeakKb) + " --out " + dir / "soak");
+  ASSERT_EQ(soak.exit_code, 0) << soak.err;
+  const std::string json = test::ReadFile(dir / "soak/soak.json");
+  ASSERT_GE(JsonNumber(json, "loops_fitted"), 3.0) << json;
+  // Frames per minute over the measured window, from the samples' own count and span.
+  const double frames_per_min = JsonNumber(json, "frames_measured") / ((JsonNumber(json, "duration_s") - kWarmupS) / 60.0);
+  const double leak_mb_per_min = 1e-3 * kLeakKb * frames_per_min;
+  const std::size_t heap_at = json.find("\"heap_mb\"");
+  ASSERT_NE(heap_at, std::string::npos) << json;
+  const double heap_slope = JsonNumber(json.substr(heap_at), "floor_slope_mb_per_min");
+  const double rss_slope = JsonNumber(json, "slope_mb_per_min");
+  std::printf("soak with a leak of %.0f kB/frame at %.0f frames/min: %.1f MB/min, heap fitted %.1f, RSS %.1f\n",
+              kLeakKb, frames_per_min, leak_mb_per_min, heap_slope, rss_slope);
+  // Frames per minute is the mean over the window, the slope the rate at its loops' floors: 10 %.
+  EXPECT_NEAR(heap_slope, leak_mb_per_min, 0.1 * leak_mb_per_min) << json;
+  EXPECT_GT(rss_slope, 0.5 * leak_mb_per_min) << json;
+  EXPECT_GT(rss_slope, 10.0) << json;
 }
 
 }  // namespace
