@@ -40,8 +40,9 @@ TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
   EXPECT_GE(JsonNumber(json, "frames_measured"), 30.0);
 
   // Memory, fitted through each whole loop's lowest sample (what is held between frames), twice.
-  // The heap in use (mallinfo2) moves only with what is allocated: +0.15 MB/min here (the run's
-  // summary), while a leak of 2 kB per frame at the ~8 frames/s of CI is ~1 MB/min. RSS moves
+  // The heap in use (mallinfo2) moves only with what is allocated: +0.03 MB/min here (+0.10-0.15
+  // while the run's summary kept every track id ever seen), while a leak of 2 kB per frame at the
+  // ~8 frames/s of CI is ~1 MB/min. RSS moves
   // by the allocator's keeping too: loop floors sit on levels ~3 MB apart (~176, ~178, ~179 MB,
   // a whole loop at ~191 now and then), and over 100 s windows of one 5-minute run their fit
   // ranged -3.1 to +3.2 MB/min with no leak; a leak of one half-resolution rig cloud per frame

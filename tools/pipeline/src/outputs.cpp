@@ -47,8 +47,33 @@ class OutputSink::Impl {
   double total_ms_sum = 0;
   std::int64_t missing_rig_frames = 0;
   std::int64_t max_tracks = 0;
-  std::set<int> track_ids;
-  std::set<int> pedestrian_ids;
+  // Distinct tracks and pedestrian tracks so far, counted as they first appear. The sets hold
+  // only the tracks alive now: a track is listed in every frame from its creation to its end and
+  // its id is never given again, so what a run of hours remembers does not grow with it.
+  std::set<int> live_track_ids, live_pedestrian_ids;
+  std::int64_t tracks_total = 0, pedestrian_tracks = 0;
+  void CountTracks(const FrameResult& r) {
+    std::set<int> live, pedestrians;
+    for (const auto& t : r.tracks) {
+      live.insert(t.id);
+      tracks_total += live_track_ids.count(t.id) == 0;
+      if (live_pedestrian_ids.count(t.id)) pedestrians.insert(t.id);  // predicted before: still one
+    }
+    for (const auto& p : r.predictions) pedestrian_tracks += pedestrians.insert(p.track_id).second;
+    live_track_ids = std::move(live);
+    live_pedestrian_ids = std::move(pedestrians);
+  }
+  // The ego's path through a stage, for its picture: every other point dropped when it reaches
+  // kMaxTrailPoints (a picture is ~1000 px across), so a long run keeps a bounded path.
+  static constexpr std::size_t kMaxTrailPoints = 4096;
+  static void ExtendTrail(std::vector<Eigen::Vector2d>* trail, const Eigen::Vector2d& xy) {
+    if (trail->size() >= kMaxTrailPoints) {
+      std::size_t kept = 0;
+      for (std::size_t k = 0; k < trail->size(); k += 2) (*trail)[kept++] = (*trail)[k];
+      trail->resize(kept);
+    }
+    trail->push_back(xy);
+  }
   std::vector<std::string> events;
   std::optional<pi::ParkingSlot> best_slot;
   std::int64_t frames_with_feasible_slot = 0;
@@ -172,8 +197,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
   s.total_ms_sum += r.status.total_latency_ms;
   if (!r.missing_rigs.empty()) ++s.missing_rig_frames;
   s.max_tracks = std::max<std::int64_t>(s.max_tracks, static_cast<std::int64_t>(r.tracks.size()));
-  for (const auto& t : r.tracks) s.track_ids.insert(t.id);
-  for (const auto& p : r.predictions) s.pedestrian_ids.insert(p.track_id);
+  s.CountTracks(r);
   s.RecordStatus(r.status);
   bool feasible = false;
   for (const auto& slot : r.slots.slots) {
@@ -190,7 +214,7 @@ void OutputSink::Write(const drivers::FrameSet* inputs, const FrameResult& r,
     if (sum.first_seq < 0) sum.first_seq = r.frame_sequence;
     sum.last_seq = r.frame_sequence;
     ++sum.frames;
-    sum.trail.push_back(r.ego_world.position_m);
+    Impl::ExtendTrail(&sum.trail, r.ego_world.position_m);
     sum.last = r;
     sum.last_truth = std::move(truth);
   }
@@ -237,8 +261,8 @@ void OutputSink::Finish(const std::string& extra_json) {
        << "\": " << (s.frames ? s.stage_ms_sum[s.stage_order[i]] / s.frames : 0.0);
   }
   js << (s.stage_order.empty() ? "" : ", ") << "\"total\": " << (s.frames ? s.total_ms_sum / s.frames : 0.0)
-     << "},\n  \"tracks_total\": " << s.track_ids.size() << ",\n  \"pedestrian_tracks\": "
-     << s.pedestrian_ids.size() << ",\n  \"frames_with_feasible_slot\": " << s.frames_with_feasible_slot
+     << "},\n  \"tracks_total\": " << s.tracks_total << ",\n  \"pedestrian_tracks\": "
+     << s.pedestrian_tracks << ",\n  \"frames_with_feasible_slot\": " << s.frames_with_feasible_slot
      << ",\n  \"best_slot\": ";
   if (s.best_slot) {
     const auto& b = *s.best_slot;
