@@ -219,6 +219,9 @@ void Soak(const SoakOptions& o) {
   if (!(o.warmup_s >= 0.0 && o.warmup_s < o.duration_s)) {
     Fail("soak: --warmup " + std::to_string(o.warmup_s) + " s must be in [0, --duration)");
   }
+  if (!(o.leak_kb_per_frame >= 0.0 && o.leak_kb_per_frame <= 1e5)) {
+    Fail("soak: --leak-kb-per-frame " + std::to_string(o.leak_kb_per_frame) + " must be in [0, 100000]");
+  }
   drivers::LogReader reader(o.log);
   if (reader.calibration() == nullptr) Fail("soak: recording " + o.log + " has no calibration (ROMO_CALIBRATION)");
   const drivers::Calibration calibration = *reader.calibration();
@@ -229,9 +232,6 @@ void Soak(const SoakOptions& o) {
   pipeline::LoopedLog looped(reader);
   fs::create_directories(o.out_dir);
 
-  if (!(o.leak_kb_per_frame >= 0.0 && o.leak_kb_per_frame <= 1e5)) {
-    Fail("soak: --leak-kb-per-frame " + std::to_string(o.leak_kb_per_frame) + " must be in [0, 100000]");
-  }
   std::vector<std::vector<char>> leaked;  // filled with non-zero bytes so its pages are resident
   std::vector<Sample> samples;
   Progress progress("soak", 0);

@@ -118,5 +118,24 @@ TEST(SoakTest, AnInjectedLeakShowsInTheMemorySlopes) {
   EXPECT_GT(rss_slope, 10.0) << json;
 }
 
+TEST(SoakTest, BadOptionsAndRecordingsAreRefusedByName) {
+  test::ScratchDir dir;
+  const std::string out = " --out " + dir / "soak";
+  const struct {
+    std::string args, named;
+  } cases[] = {
+      {"x.lcmlog --duration 0", "--duration"},
+      {"x.lcmlog --duration 10 --warmup 10", "--warmup"},
+      {"x.lcmlog --leak-kb-per-frame -1", "--leak-kb-per-frame"},
+      {"x.lcmlog --leak-kb-per-frame nan", "--leak-kb-per-frame"},
+      {dir / "missing.lcmlog", "missing.lcmlog"},
+  };
+  for (const auto& c : cases) {
+    const auto res = test::RunRomo("soak " + c.args + out);
+    EXPECT_NE(res.exit_code, 0) << c.args;
+    EXPECT_NE(res.err.find(c.named), std::string::npos) << c.args << ": " << res.err;
+  }
+}
+
 }  // namespace
 }  // namespace romo
