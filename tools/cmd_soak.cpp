@@ -272,11 +272,14 @@ void Soak(const SoakOptions& o) {
   // Fewer than 3 whole loops (a long recording or a slow host) leave only the raw samples.
   const bool loops_fit = rss_loops.peaks.size() >= 3;
   const Fit rss_samples = LeastSquares(measured, &Sample::rss_mb);
-  const Fit rss_floor = loops_fit ? LeastSquares(rss_loops.floors, &Sample::rss_mb) : rss_samples;
-  const Fit rss_peak = loops_fit ? LeastSquares(rss_loops.peaks, &Sample::rss_mb) : rss_samples;
-  const double rss_slope = rss_floor.slope;
+  // Through the loops' floors (or peaks), or the fit over the samples with too few loops.
+  const auto loop_fit = [&](const std::vector<Sample>& per_loop, double Sample::*field, const Fit& samples) {
+    return loops_fit ? LeastSquares(per_loop, field) : samples;
+  };
+  const Fit rss_floor = loop_fit(rss_loops.floors, &Sample::rss_mb, rss_samples);
+  const Fit rss_peak = loop_fit(rss_loops.peaks, &Sample::rss_mb, rss_samples);
   const Fit heap_samples = LeastSquares(measured, &Sample::heap_mb);
-  const Fit heap_floor = loops_fit ? LeastSquares(heap_loops.floors, &Sample::heap_mb) : heap_samples;
+  const Fit heap_floor = loop_fit(heap_loops.floors, &Sample::heap_mb, heap_samples);
   const Fit latency = LeastSquares(measured, &Sample::latency_ms);
   const Fit cpu = LeastSquares(measured, &Sample::cpu_ms);
   const TracksPerLoop tracks = CompareLoops(measured);
@@ -313,7 +316,7 @@ void Soak(const SoakOptions& o) {
                   JsonEscape(o.log).c_str(), wall_s, o.warmup_s, static_cast<long long>(stats.frames), measured.size(),
                   static_cast<long long>(looped.loops()), static_cast<long long>(stats.skipped_out_of_order),
                   measured.front().rss_mb, measured.back().rss_mb,
-                  *std::max_element(rss_values.begin(), rss_values.end()), rss_samples.mean, rss_slope, rss_floor.slope,
+                  *std::max_element(rss_values.begin(), rss_values.end()), rss_samples.mean, rss_floor.slope, rss_floor.slope,
                   rss_peak.slope, rss_samples.slope, loops_fit ? rss_loops.peaks.size() : std::size_t{0},
                   measured.front().heap_mb, measured.back().heap_mb, heap_samples.mean, heap_floor.slope,
                   heap_samples.slope, latency.mean,
@@ -333,7 +336,7 @@ void Soak(const SoakOptions& o) {
   std::printf("soak: %lld frames (%lld loops of %s) in %.1f s; after %.0f s warm-up: RSS %.1f MB, loop floor slope %+.3f MB/min, heap %+.3f MB/min, "
               "latency mean %.1f ms slope %+.3f ms/min, CPU %.1f ms/frame slope %+.3f ms/min; %s/soak.{json,csv,png}\n",
               static_cast<long long>(stats.frames), static_cast<long long>(looped.loops()), o.log.c_str(), wall_s,
-              o.warmup_s, rss_samples.mean, rss_slope, heap_floor.slope, latency.mean, latency.slope, cpu.mean, cpu.slope,
+              o.warmup_s, rss_samples.mean, rss_floor.slope, heap_floor.slope, latency.mean, latency.slope, cpu.mean, cpu.slope,
               o.out_dir.c_str());
 }
 

@@ -22,6 +22,16 @@ double JsonNumber(const std::string& json, const std::string& key) {
   return std::stod(json.substr(at + key.size() + 3));
 }
 
+// The heap in use's slope through the loop floors (soak.json heap_mb).
+double HeapFloorSlope(const std::string& json) {
+  const std::size_t heap_at = json.find("\"heap_mb\"");
+  if (heap_at == std::string::npos) {
+    ADD_FAILURE() << "soak.json has no heap_mb:\n" << json;
+    return 0.0;
+  }
+  return JsonNumber(json.substr(heap_at), "floor_slope_mb_per_min");
+}
+
 TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
   test::ScratchDir dir;
   // Half resolution: more frames per minute on shared cores, so the fits rest on more samples.
@@ -42,15 +52,13 @@ TEST(SoakTest, TwoMinuteLoopedReplayKeepsMemoryAndLatencyFlat) {
   // Memory, fitted through each whole loop's lowest sample (what is held between frames), twice.
   // The heap in use (mallinfo2) moves only with what is allocated: +0.03 MB/min here (+0.10-0.15
   // while the run's summary kept every track id ever seen), while a leak of 2 kB per frame at the
-  // ~8 frames/s of CI is ~1 MB/min. RSS moves
-  // by the allocator's keeping too: loop floors sit on levels ~3 MB apart (~176, ~178, ~179 MB,
-  // a whole loop at ~191 now and then), and over 100 s windows of one 5-minute run their fit
-  // ranged -3.1 to +3.2 MB/min with no leak; a leak of one half-resolution rig cloud per frame
-  // (~25k points x 16 B = 0.4 MB) grows it 24 MB/min even at 1 frame/s.
-  const std::size_t heap_at = json.find("\"heap_mb\"");
-  ASSERT_NE(heap_at, std::string::npos) << json;
+  // ~8 frames/s of CI is ~1 MB/min. RSS moves by the allocator's keeping too: loop floors sit on
+  // levels ~3 MB apart (~176, ~178, ~179 MB, a whole loop at ~191 now and then), and over 100 s
+  // windows of one 5-minute run their fit ranged -3.1 to +3.2 MB/min with no leak; a leak of one
+  // half-resolution rig cloud per frame (~25k points x 16 B = 0.4 MB) grows it 24 MB/min even at
+  // 1 frame/s.
   constexpr double kMaxHeapSlopeMbPerMin = 1.0, kMaxRssSlopeMbPerMin = 10.0;
-  EXPECT_LT(JsonNumber(json.substr(heap_at), "floor_slope_mb_per_min"), kMaxHeapSlopeMbPerMin) << json;
+  EXPECT_LT(HeapFloorSlope(json), kMaxHeapSlopeMbPerMin) << json;
   EXPECT_LT(JsonNumber(json, "slope_mb_per_min"), kMaxRssSlopeMbPerMin) << json;
   EXPECT_GE(JsonNumber(json, "loops_fitted"), 3.0) << "too few whole loops for the RSS fit:\n" << json;
   // Every loop replays the same frames, so the tracks held per frame must not grow from the
@@ -106,9 +114,7 @@ TEST(SoakTest, AnInjectedLeakShowsInTheMemorySlopes) {
   // Frames per minute over the measured window, from the samples' own count and span.
   const double frames_per_min = JsonNumber(json, "frames_measured") / ((JsonNumber(json, "duration_s") - kWarmupS) / 60.0);
   const double leak_mb_per_min = 1e-3 * kLeakKb * frames_per_min;
-  const std::size_t heap_at = json.find("\"heap_mb\"");
-  ASSERT_NE(heap_at, std::string::npos) << json;
-  const double heap_slope = JsonNumber(json.substr(heap_at), "floor_slope_mb_per_min");
+  const double heap_slope = HeapFloorSlope(json);
   const double rss_slope = JsonNumber(json, "slope_mb_per_min");
   std::printf("soak with a leak of %.0f kB/frame at %.0f frames/min: %.1f MB/min, heap fitted %.1f, RSS %.1f\n",
               kLeakKb, frames_per_min, leak_mb_per_min, heap_slope, rss_slope);
