@@ -90,6 +90,9 @@ void TrackerParams::Validate() const {
     bad("companion_max_speed_diff_mps", companion_max_speed_diff_mps, "need >= 0");
   }
   if (!(companion_max_occlusion_s >= 0.0)) bad("companion_max_occlusion_s", companion_max_occlusion_s, "need >= 0");
+  if (!(companion_standing_min_gap_m >= 0.0)) {
+    bad("companion_standing_min_gap_m", companion_standing_min_gap_m, "need >= 0");
+  }
   predictor.Validate();
 }
 
@@ -182,14 +185,15 @@ double Tracker::Impl::MaxOcclusion(const TrackState_& s) const {
 }
 
 void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
-  // Companions: pedestrian tracks measured alone now and walking.
-  const double min_speed = params_.companion_min_speed_mps;
-  std::vector<std::size_t> walking;
+  // Companions: pedestrian tracks measured alone now. A companion is taken only while walking (two
+  // people standing near each other need not be together), then followed while it stands too:
+  // people walking together stop together, and the hidden one waits behind the one seen.
+  std::vector<std::size_t> measured, walking;
   for (std::size_t i = 0; i < states_.size(); ++i) {
     const TrackState_& c = states_[i];
-    if (updated[i] && !c.track.merged && c.track.class_index == pedestrian_ && c.x.tail<2>().norm() >= min_speed) {
-      walking.push_back(i);
-    }
+    if (!updated[i] || c.track.merged || c.track.class_index != pedestrian_) continue;
+    measured.push_back(i);
+    if (c.x.tail<2>().norm() >= params_.companion_min_speed_mps) walking.push_back(i);
   }
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
@@ -212,10 +216,14 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
       }
     }
     if (t.companion_id < 0) continue;
-    const auto c = std::find_if(walking.begin(), walking.end(),
+    const auto c = std::find_if(measured.begin(), measured.end(),
                                 [&](std::size_t k) { return states_[k].track.id == t.companion_id; });
-    if (c == walking.end()) {
-      t.companion_id = -1;  // the companion is hidden or stopped too: coast alone from here
+    // (Standing close by, the two are as likely one person tracked twice, sharing one blob.)
+    const bool stands_close = c != measured.end() &&
+                              states_[*c].x.tail<2>().norm() < params_.companion_min_speed_mps &&
+                              s.companion_offset.norm() < params_.companion_standing_min_gap_m;
+    if (c == measured.end() || stands_close) {
+      t.companion_id = -1;  // the companion is hidden too, or stands close by: coast alone from here
       continue;
     }
     const TrackState_& companion = states_[*c];

@@ -228,6 +228,41 @@ TEST(TrackerTest, HiddenWalkerFollowsTheCompanionSeenBesideIt) {
   EXPECT_GT(coasted.score.misses, followed.score.misses + 15);
 }
 
+TEST(TrackerTest, HiddenWalkerWaitsWithItsCompanionWhenItStops) {
+  // Two people walk side by side 1.3 m apart (the simulated scene's pair walking one behind the
+  // other); the far one is hidden from 2 s to 6.5 s, while both stop for 2.5 s at 3 s and then
+  // walk off at right angles.
+  std::vector<Walker> walkers = {
+      {1, {-4.0, 0.0}, {1.2, 0.0}},
+      {2, {-4.0, 1.3}, {1.2, 0.0}, 2.0, 6.5},
+  };
+  for (Walker& w : walkers) {
+    w.turn_s = 3.0;
+    w.turn2_s = 5.5;
+    w.velocity_after2 = Eigen::Vector2d(0.0, 1.0);
+  }
+  // The hidden track stands with its companion and takes the walker back when it shows again.
+  const SceneResult waited = RunScene(walkers, 8.0);
+  EXPECT_EQ(waited.tracks_created, 2) << "the hidden walker's track must survive the stop";
+  EXPECT_EQ(waited.score.id_switches, 0);
+  EXPECT_GE(waited.lost_frames, 44);  // all 45 hidden frames reported (at most one re-association frame short)
+  EXPECT_LT(waited.score.max_error_m, kMaxErrorM);
+  // Coasting alone, the track is dropped 2 s after it was last seen: the walker comes back as a
+  // new track.
+  TrackerParams alone;
+  alone.companion_max_gap_m = 0.0;
+  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
+  EXPECT_EQ(coasted.tracks_created, 3);
+  EXPECT_GT(coasted.score.misses, waited.score.misses + 15);
+  // Lost within companion_standing_min_gap_m of a companion who stops, a track is as likely the
+  // same person tracked twice: it waits with no one and ends like one coasting alone.
+  TrackerParams wide;
+  wide.companion_standing_min_gap_m = 1.5;
+  const SceneResult not_waited = RunScene(walkers, 8.0, 0.0, wide);
+  EXPECT_EQ(not_waited.tracks_created, 3);
+  EXPECT_EQ(not_waited.lost_frames, coasted.lost_frames);
+}
+
 TEST(TrackerTest, MergedPedestriansBothSurviveAndSplit) {
   // Two walkers pass each other head-on 0.6 m apart: for ~0.6 s stereo sees one blob
   // (Fig. 4.16 bottom); both tracks must share it and come out with their own ids.
@@ -338,6 +373,10 @@ TEST(TrackerTest, RejectsBadInput) {
   params = TrackerParams{};
   params.companion_max_gap_m = std::nan("");
   EXPECT_NE(test::ErrorOf([&] { Tracker t(atlas, params); }).find("companion_max_gap_m = nan"), std::string::npos);
+  params = TrackerParams{};
+  params.companion_standing_min_gap_m = -0.5;
+  EXPECT_NE(test::ErrorOf([&] { Tracker t(atlas, params); }).find("companion_standing_min_gap_m = -0.5"),
+            std::string::npos);
   Tracker tracker(atlas, TrackerParams{});
   tracker.Update(1.0, {});
   EXPECT_THROW(tracker.Update(1.0, {}), romo::Error);

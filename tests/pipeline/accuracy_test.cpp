@@ -194,7 +194,11 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // boxes stand on the ground (ground_contact_gap_m) and the Atlas's walkers and riders are 1.5 m
   // tall and up: pedestrian P 0.904 -> 0.889, R 0.764 -> 0.813 (visible 0.819 -> 0.865, hidden
   // 0.39 -> 0.45), car P 0.945 -> 0.950, R 0.866 -> 0.859 (hidden 0.785 -> 0.731: memories half a
-  // bay off), centre 0.262 -> 0.274 m (the people now found are the harder ones).
+  // bay off), centre 0.262 -> 0.274 m (the people now found are the harder ones). Session 30:
+  // the far one of two people one behind the other, seen as a sliver beside the near one, is a
+  // person too (tandem_far_partly_seen): pedestrian P 0.889 -> 0.890, R 0.813 -> 0.817, centre
+  // 0.274 -> 0.270 m (at full resolution, seeds 1-5 with the tracker's standing companions:
+  // pedestrians 0.942 / 0.859 -> 0.953 / 0.895).
   EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
@@ -216,9 +220,10 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
 // work), seed 1 only to keep CI short. Here more of the targets are met, and asserted:
 // car and pedestrian precision >= 0.95, box centre within 0.2 m, the bay found in every frame it
 // is fully visible; the others are floors a little under seed 1's figures (car P 0.983 R 0.947,
-// pedestrian P 0.982 R 0.857, centre 0.185 m, slot 32/32 at 0.056 m; car recall was 0.665 before
+// pedestrian P 0.989 R 0.908, centre 0.186 m, slot 32/32 at 0.056 m; car recall was 0.665 before
 // parked cars were placed by their row's paint, session 25; pedestrians 0.955 / 0.760 before boxes
-// stood on the ground, session 28).
+// stood on the ground, session 28, 0.982 / 0.857 before the far one of a pair in single file was
+// kept from a sliver and a hidden walker waited with its companion, session 30).
 TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   romo::test::ScratchDir dir;
   const auto run = romo::test::RunRomo("run --no-pictures --scale 1 --seed 1 --out " + dir.path());
@@ -234,7 +239,7 @@ TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   EXPECT_GE(e.car.precision(), 0.95);
   EXPECT_GE(e.car.recall(), 0.92);
   EXPECT_GE(e.pedestrian.precision(), 0.95);
-  EXPECT_GE(e.pedestrian.recall(), 0.82);
+  EXPECT_GE(e.pedestrian.recall(), 0.88);
 }
 
 }  // namespace

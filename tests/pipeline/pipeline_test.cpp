@@ -647,6 +647,44 @@ TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {
   EXPECT_EQ(pedestrians(single).size(), 1u);
 }
 
+// The far one of two people one behind the other shows only a sliver beside the near one (the
+// simulated scene's pair at 4-5 m: 0.04-0.3 m of them wide): too thin for a person on its own,
+// it is one partly seen behind the person in front (PipelineParams::tandem_far_partly_seen).
+TEST(PipelineTest, APersonHalfHiddenBehindAnotherIsStillAPerson) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  RigInput in = PeopleAhead({5.f});
+  // The far person's side at y 0.165-0.225 m: a sliver 0.06 m wide, 1.7 m tall, 0.45 m deep.
+  for (float z = 0.05f; z <= 1.7f; z += 0.04f) {
+    for (float x = 5.375f; x <= 5.826f; x += 0.03f) {
+      for (float y : {0.165f, 0.195f, 0.225f}) in.cloud.PushBack({x, y, z}, 0.01f, 50.f);
+    }
+  }
+  auto classes_near = [](const FrameResult& r, double x) {
+    std::vector<std::string> out;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (std::abs(o.center_m.x() - x) < 0.3) out.push_back(o.class_name);
+    }
+    return out;
+  };
+  PipelineParams both_whole;
+  both_whole.tandem_far_partly_seen = false;
+  const FrameResult strict = Pipeline(calibration, both_whole).ProcessClouds(1000, 1, {in}, std::nullopt, std::nullopt);
+  ASSERT_EQ(strict.blobs.size(), 1u) << "the two must touch for this test";
+  EXPECT_NE(classes_near(strict, 5.6), std::vector<std::string>{"pedestrian"});
+
+  const FrameResult r = Pipeline(calibration, PipelineParams{}).ProcessClouds(1000, 1, {in}, std::nullopt, std::nullopt);
+  ASSERT_EQ(r.obstacles.obstacles.size(), 2u);
+  EXPECT_EQ(classes_near(r, 5.0), std::vector<std::string>{"pedestrian"});
+  ASSERT_EQ(classes_near(r, 5.6), std::vector<std::string>{"pedestrian"});
+  for (const auto& o : r.obstacles.obstacles) {
+    if (std::abs(o.center_m.x() - 5.6) >= 0.3) continue;
+    // The sliver's box: its points' middle (y 0.195), from the ground up to its top (1.7 m).
+    EXPECT_NEAR(o.center_m.y(), 0.195, kBoxCentreTolM);
+    EXPECT_NEAR(o.center_m.z() - 0.5 * o.size_m.z(), 0.0, 0.01);
+    EXPECT_NEAR(o.size_m.z(), 1.7, 0.08);
+  }
+}
+
 TEST(PipelineTest, ACoastingPersonKeepsAPersonsSizeWhateverItsLastBlobWas) {
   const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
   Pipeline pipe(calibration, PipelineParams{});

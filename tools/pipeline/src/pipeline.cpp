@@ -1067,32 +1067,54 @@ class Pipeline::Impl {
     }
   }
 
-  // Replaces blob @p i by @p parts when both are blobs (min_blob_points) of class @p class_index
-  // as seen from the blob's camera; the second part is appended. Whether it did.
+  // A part of a blob, boxed and seen from the blob's camera.
+  struct Part {
+    objects::Box3 box;
+    Seen seen;
+  };
+  // Both @p parts of blob @p i boxed and seen; nullopt when either is too small for a blob
+  // (min_blob_points).
+  std::optional<std::array<Part, 2>> SeeParts(std::size_t i, const std::array<std::vector<int>, 2>& parts,
+                                              const FrameResult& r, const Eigen::Vector3f& up,
+                                              const std::vector<Eigen::Vector2f>& viewers) const {
+    const auto min_points = static_cast<std::size_t>(params.segmentation.min_blob_points);
+    if (parts[0].size() < min_points || parts[1].size() < min_points) return std::nullopt;
+    std::array<Part, 2> out;
+    for (std::size_t h = 0; h < 2; ++h) {
+      out[h].box = FitStandingBox(r, parts[h], up, viewers[i]);
+      out[h].seen = See(r, out[h].box, parts[h], viewers[i]);
+    }
+    return out;
+  }
+  // Replaces blob @p i by @p parts, seen as @p seen_parts; the second part is appended.
+  static void ReplaceByParts(std::size_t i, std::array<std::vector<int>, 2> parts, const std::array<Part, 2>& seen_parts,
+                             FrameResult& r, std::vector<Eigen::Vector2f>* viewers, std::vector<Seen>* seen) {
+    r.boxes[i] = seen_parts[0].box;
+    r.blobs[i] = std::move(parts[0]);
+    (*seen)[i] = seen_parts[0].seen;
+    r.boxes.push_back(seen_parts[1].box);
+    r.blobs.push_back(std::move(parts[1]));
+    seen->push_back(seen_parts[1].seen);
+    viewers->push_back((*viewers)[i]);
+  }
+  // Replaces blob @p i by @p parts when both are blobs of class @p class_index. Whether it did.
   bool SplitWhenBothAre(int class_index, std::size_t i, std::array<std::vector<int>, 2> parts, FrameResult& r,
                         const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
                         std::vector<Seen>* seen) const {
-    const auto min_points = static_cast<std::size_t>(params.segmentation.min_blob_points);
-    if (parts[0].size() < min_points || parts[1].size() < min_points) return false;
-    objects::Box3 boxes[2];
-    Seen views[2];
-    for (int h = 0; h < 2; ++h) {
-      boxes[h] = FitStandingBox(r, parts[h], up, (*viewers)[i]);
-      views[h] = See(r, boxes[h], parts[h], (*viewers)[i]);
-      if (views[h].viewed.classification.class_index != class_index) return false;
+    const std::optional<std::array<Part, 2>> seen_parts = SeeParts(i, parts, r, up, *viewers);
+    if (!seen_parts || std::any_of(seen_parts->begin(), seen_parts->end(), [&](const Part& part) {
+          return part.seen.viewed.classification.class_index != class_index;
+        })) {
+      return false;
     }
-    r.boxes[i] = boxes[0];
-    r.blobs[i] = std::move(parts[0]);
-    (*seen)[i] = views[0];
-    r.boxes.push_back(boxes[1]);
-    r.blobs.push_back(std::move(parts[1]));
-    seen->push_back(views[1]);
-    viewers->push_back((*viewers)[i]);
+    ReplaceByParts(i, std::move(parts), *seen_parts, r, viewers, seen);
     return true;
   }
 
   // Splits pedestrian-tall blobs too long for one person (two people walking one behind the
-  // other along the sight line) in two along their length, when both halves are pedestrians.
+  // other along the sight line) in two along their length, when both halves are pedestrians, or
+  // the nearer one is and the farther one, hidden behind it in part, can be one partly seen
+  // (PipelineParams::tandem_far_partly_seen).
   void SplitTandems(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
                     std::vector<Seen>* seen) const {
     if (params.tandem_min_length_m <= 0.0 || pedestrian_class < 0) return;
@@ -1110,7 +1132,29 @@ class Pipeline::Impl {
       // end seen head-on is as tall and thin, and its halves as wide as people).
       const Eigen::Vector2f sight = box.center.head<2>() - (*viewers)[i];
       if (std::abs(box.axes.col(0).head<2>().dot(sight.normalized())) < kCos45) continue;
-      SplitWhenBothAre(pedestrian_class, i, SplitAlong(r.cloud, r.blobs[i], box.axes.col(0)), r, up, viewers, seen);
+      std::array<std::vector<int>, 2> halves = SplitAlong(r.cloud, r.blobs[i], box.axes.col(0));
+      std::optional<std::array<Part, 2>> parts = SeeParts(i, halves, r, up, *viewers);
+      if (!parts) continue;
+      auto is_person = [&](const Part& part) {
+        return part.seen.viewed.classification.class_index == pedestrian_class;
+      };
+      if (!is_person((*parts)[0]) || !is_person((*parts)[1])) {
+        if (!params.tandem_far_partly_seen || is_person((*parts)[0]) == is_person((*parts)[1])) continue;
+        const std::size_t near = is_person((*parts)[0]) ? 0 : 1;
+        Part& far = (*parts)[1 - near];
+        const float near_range = ((*parts)[near].box.center.head<2>() - (*viewers)[i]).norm();
+        // (no deeper than a person: a car's side behind a piece of its end is a sheet 1.1 m long)
+        if (!Unclassified(far.seen) || (far.box.center.head<2>() - (*viewers)[i]).norm() <= near_range ||
+            far.box.size.x() > ped.length.mean_m + ped.length.sigma_m) {
+          continue;
+        }
+        const std::optional<objects::Box3> person = PartlySeenPerson(r, up, far.box);
+        if (!person) continue;
+        far.box = *person;
+        far.seen.viewed.box = *person;
+        far.seen.viewed.classification = (*parts)[near].seen.viewed.classification;
+      }
+      ReplaceByParts(i, std::move(halves), *parts, r, viewers, seen);
     }
   }
 

@@ -88,6 +88,10 @@ struct PipelineParams {
   /// sight line stay one blob (0.6 m apart on the simulated scene: 56 of 196 pedestrian sightings
   /// lost). 0.9 m is longer than one person's stride (Atlas pedestrian mean + 1.2 sigma). 0 = off.
   double tandem_min_length_m = 0.9;
+  /// ... or when the nearer half is a pedestrian and the farther half, hidden behind it in part
+  /// (a sliver beside it, or legs below it), can be one partly seen (PartlySeenPerson): the far
+  /// one is then a pedestrian too, its box from the ground up. false = both must read as people.
+  bool tandem_far_partly_seen = true;
   /// A blob at least this long seen across its length (the sight line nearer its width than its
   /// length) is split at the emptiest stretch inside it (or the next emptiest, and so on) holding
   /// less than face_pair_gap_density of the blob's median points per length where both parts are cars: the
