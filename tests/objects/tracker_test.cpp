@@ -202,9 +202,27 @@ TEST(TrackerTest, OcclusionLongerThanLimitEndsTrack) {
   EXPECT_EQ(r.tracks_created, 2);
 }
 
+// Walker 2 of @p walkers is hidden for @p hidden_frames (more than the pedestrian's 2 s coasting
+// limit) beside walker 1. Followed, its track survives, stays beside its companion and takes the
+// walker back; coasting alone (no companion) it is dropped 2 s after it was last seen, and the
+// walker comes back as a new track. Returns the run without companions.
+SceneResult ExpectTheCompanionKeepsTheHiddenWalker(const std::vector<Walker>& walkers, int hidden_frames) {
+  const SceneResult followed = RunScene(walkers, 8.0);
+  EXPECT_EQ(followed.tracks_created, 2) << "the hidden walker's track must survive";
+  EXPECT_EQ(followed.score.id_switches, 0);
+  EXPECT_GE(followed.lost_frames, hidden_frames - 1);  // at most one re-association frame short
+  EXPECT_LT(followed.score.max_error_m, kMaxErrorM);
+  TrackerParams alone;
+  alone.companion_max_gap_m = 0.0;
+  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
+  EXPECT_EQ(coasted.tracks_created, 3);
+  EXPECT_GT(coasted.score.misses, followed.score.misses + 15);
+  return coasted;
+}
+
 TEST(TrackerTest, HiddenWalkerFollowsTheCompanionSeenBesideIt) {
-  // Two people walk side by side 1 m apart; the far one is hidden behind the near one for 4 s
-  // (twice the pedestrian's 2 s coasting limit), during which both turn 45 degrees and slow down.
+  // Two people walk side by side 1 m apart; the far one is hidden behind the near one for 4 s,
+  // during which both turn 45 degrees and slow down.
   std::vector<Walker> walkers = {
       {1, {-4.0, 0.0}, {1.3, 0.0}},
       {2, {-4.0, 1.0}, {1.3, 0.0}, 2.0, 6.0},
@@ -213,19 +231,7 @@ TEST(TrackerTest, HiddenWalkerFollowsTheCompanionSeenBesideIt) {
     w.turn_s = 3.5;
     w.velocity_after = Eigen::Vector2d(0.7, 0.7);
   }
-  // Followed: the track survives, stays beside its companion and takes the walker back.
-  const SceneResult followed = RunScene(walkers, 8.0);
-  EXPECT_EQ(followed.tracks_created, 2) << "the hidden walker's track must survive the 4 s";
-  EXPECT_EQ(followed.score.id_switches, 0);
-  EXPECT_GE(followed.lost_frames, 39);  // all 40 hidden frames reported (at most one re-association frame short)
-  EXPECT_LT(followed.score.max_error_m, kMaxErrorM);
-  // Coasting alone, the track runs on straight at the old speed and is dropped after 2 s: the
-  // walker comes back as a new track.
-  TrackerParams alone;
-  alone.companion_max_gap_m = 0.0;
-  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
-  EXPECT_EQ(coasted.tracks_created, 3);
-  EXPECT_GT(coasted.score.misses, followed.score.misses + 15);
+  ExpectTheCompanionKeepsTheHiddenWalker(walkers, 40);
 }
 
 TEST(TrackerTest, HiddenWalkerWaitsWithItsCompanionWhenItStops) {
@@ -241,19 +247,7 @@ TEST(TrackerTest, HiddenWalkerWaitsWithItsCompanionWhenItStops) {
     w.turn2_s = 5.5;
     w.velocity_after2 = Eigen::Vector2d(0.0, 1.0);
   }
-  // The hidden track stands with its companion and takes the walker back when it shows again.
-  const SceneResult waited = RunScene(walkers, 8.0);
-  EXPECT_EQ(waited.tracks_created, 2) << "the hidden walker's track must survive the stop";
-  EXPECT_EQ(waited.score.id_switches, 0);
-  EXPECT_GE(waited.lost_frames, 44);  // all 45 hidden frames reported (at most one re-association frame short)
-  EXPECT_LT(waited.score.max_error_m, kMaxErrorM);
-  // Coasting alone, the track is dropped 2 s after it was last seen: the walker comes back as a
-  // new track.
-  TrackerParams alone;
-  alone.companion_max_gap_m = 0.0;
-  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
-  EXPECT_EQ(coasted.tracks_created, 3);
-  EXPECT_GT(coasted.score.misses, waited.score.misses + 15);
+  const SceneResult coasted = ExpectTheCompanionKeepsTheHiddenWalker(walkers, 45);
   // Lost within companion_standing_min_gap_m of a companion who stops, a track is as likely the
   // same person tracked twice: it waits with no one and ends like one coasting alone.
   TrackerParams wide;
