@@ -188,12 +188,13 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
   // Companions: pedestrian tracks measured alone now. A companion is taken only while walking (two
   // people standing near each other need not be together), then followed while it stands too:
   // people walking together stop together, and the hidden one waits behind the one seen.
+  auto walks = [&](const TrackState_& c) { return c.x.tail<2>().norm() >= params_.companion_min_speed_mps; };
   std::vector<std::size_t> measured, walking;
   for (std::size_t i = 0; i < states_.size(); ++i) {
     const TrackState_& c = states_[i];
     if (!updated[i] || c.track.merged || c.track.class_index != pedestrian_) continue;
     measured.push_back(i);
-    if (c.x.tail<2>().norm() >= params_.companion_min_speed_mps) walking.push_back(i);
+    if (walks(c)) walking.push_back(i);
   }
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
@@ -219,8 +220,7 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
     const auto c = std::find_if(measured.begin(), measured.end(),
                                 [&](std::size_t k) { return states_[k].track.id == t.companion_id; });
     // (Standing close by, the two are as likely one person tracked twice, sharing one blob.)
-    const bool stands_close = c != measured.end() &&
-                              states_[*c].x.tail<2>().norm() < params_.companion_min_speed_mps &&
+    const bool stands_close = c != measured.end() && !walks(states_[*c]) &&
                               s.companion_offset.norm() < params_.companion_standing_min_gap_m;
     if (c == measured.end() || stands_close) {
       t.companion_id = -1;  // the companion is hidden too, or stands close by: coast alone from here

@@ -1111,6 +1111,29 @@ class Pipeline::Impl {
     return true;
   }
 
+  bool IsPerson(const Part& part) const { return part.seen.viewed.classification.class_index == pedestrian_class; }
+  // When the nearer of @p halves is a person and the farther, of no class behind it, can be one
+  // partly seen (no deeper than a person: a car's side behind a piece of its end is a sheet 1.1 m
+  // long), the farther becomes that person, boxed from the ground up. Whether it did.
+  bool SeeFarHalfPartlySeen(const FrameResult& r, const Eigen::Vector3f& up, const Eigen::Vector2f& viewer,
+                            std::array<Part, 2>* halves) const {
+    if (IsPerson((*halves)[0]) == IsPerson((*halves)[1])) return false;
+    const Part& near = IsPerson((*halves)[0]) ? (*halves)[0] : (*halves)[1];
+    Part& far = IsPerson((*halves)[0]) ? (*halves)[1] : (*halves)[0];
+    const objects::ObjectClass& ped = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
+    if (!Unclassified(far.seen) ||
+        (far.box.center.head<2>() - viewer).norm() <= (near.box.center.head<2>() - viewer).norm() ||
+        far.box.size.x() > ped.length.mean_m + ped.length.sigma_m) {
+      return false;
+    }
+    const std::optional<objects::Box3> person = PartlySeenPerson(r, up, far.box);
+    if (!person) return false;
+    far.box = *person;
+    far.seen.viewed.box = *person;
+    far.seen.viewed.classification = near.seen.viewed.classification;
+    return true;
+  }
+
   // Splits pedestrian-tall blobs too long for one person (two people walking one behind the
   // other along the sight line) in two along their length, when both halves are pedestrians, or
   // the nearer one is and the farther one, hidden behind it in part, can be one partly seen
@@ -1135,24 +1158,9 @@ class Pipeline::Impl {
       std::array<std::vector<int>, 2> halves = SplitAlong(r.cloud, r.blobs[i], box.axes.col(0));
       std::optional<std::array<Part, 2>> parts = SeeParts(i, halves, r, up, *viewers);
       if (!parts) continue;
-      auto is_person = [&](const Part& part) {
-        return part.seen.viewed.classification.class_index == pedestrian_class;
-      };
-      if (!is_person((*parts)[0]) || !is_person((*parts)[1])) {
-        if (!params.tandem_far_partly_seen || is_person((*parts)[0]) == is_person((*parts)[1])) continue;
-        const std::size_t near = is_person((*parts)[0]) ? 0 : 1;
-        Part& far = (*parts)[1 - near];
-        const float near_range = ((*parts)[near].box.center.head<2>() - (*viewers)[i]).norm();
-        // (no deeper than a person: a car's side behind a piece of its end is a sheet 1.1 m long)
-        if (!Unclassified(far.seen) || (far.box.center.head<2>() - (*viewers)[i]).norm() <= near_range ||
-            far.box.size.x() > ped.length.mean_m + ped.length.sigma_m) {
-          continue;
-        }
-        const std::optional<objects::Box3> person = PartlySeenPerson(r, up, far.box);
-        if (!person) continue;
-        far.box = *person;
-        far.seen.viewed.box = *person;
-        far.seen.viewed.classification = (*parts)[near].seen.viewed.classification;
+      const bool both_people = IsPerson((*parts)[0]) && IsPerson((*parts)[1]);
+      if (!both_people && !(params.tandem_far_partly_seen && SeeFarHalfPartlySeen(r, up, (*viewers)[i], &*parts))) {
+        continue;
       }
       ReplaceByParts(i, std::move(halves), *parts, r, viewers, seen);
     }
