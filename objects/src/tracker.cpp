@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/Cholesky>
@@ -38,6 +39,8 @@ struct TrackState_ {
   std::unique_ptr<PathPredictor> predictor;
   int misses = 0;
   Eigen::Vector2d companion_offset = Eigen::Vector2d::Zero();  // from the companion, when lost
+  // Last placed by a measured companion: as good as seen then, so its own coast starts there.
+  double placed_s = -std::numeric_limits<double>::infinity();
   std::vector<int> votes;         // per Atlas class
   std::vector<double> vote_score;  // summed scores per class
 };
@@ -123,7 +126,7 @@ class Tracker::Impl {
   bool MayHoldSeveral(const Detection& d) const;
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
   double MaxOcclusion(const TrackState_& s) const;
-  void FollowCompanions(const std::vector<char>& updated);
+  void FollowCompanions(const std::vector<char>& updated, double stamp_s);
   void Observe(TrackState_* s, const Detection& d, double stamp_s) const;
 };
 
@@ -184,18 +187,17 @@ double Tracker::Impl::MaxOcclusion(const TrackState_& s) const {
   return limit;
 }
 
-void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
+void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, double stamp_s) {
   // Companions: pedestrian tracks measured alone now. A companion is taken only while walking (two
   // people standing near each other need not be together), then followed while it stands too:
-  // people walking together stop together, and the hidden one waits behind the one seen.
+  // people walking together stop together, and the hidden one waits behind the one seen. Hidden
+  // too, the companion is followed as it coasts: the two walk on together, and when it is seen
+  // again the follower is placed beside it again.
   auto walks = [&](const TrackState_& c) { return c.x.tail<2>().norm() >= params_.companion_min_speed_mps; };
-  std::vector<std::size_t> measured, walking;
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    const TrackState_& c = states_[i];
-    if (!updated[i] || c.track.merged || c.track.class_index != pedestrian_) continue;
-    measured.push_back(i);
-    if (walks(c)) walking.push_back(i);
-  }
+  auto measured = [&](std::size_t k) {
+    const TrackState_& c = states_[k];
+    return updated[k] && !c.track.merged && c.track.class_index == pedestrian_;
+  };
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
     Track& t = s.track;
@@ -206,8 +208,9 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
     if (t.companion_id < 0 && s.misses == 0) {
       // Lost just now: the nearest walker beside it moving alike (the predictions still agree).
       double best = params_.companion_max_gap_m;
-      for (std::size_t k : walking) {
+      for (std::size_t k = 0; k < states_.size(); ++k) {
         const TrackState_& c = states_[k];
+        if (!measured(k) || !walks(c)) continue;
         const double gap = (s.x.head<2>() - c.x.head<2>()).norm();
         if (gap <= best && (s.x.tail<2>() - c.x.tail<2>()).norm() <= params_.companion_max_speed_diff_mps) {
           best = gap;
@@ -217,19 +220,23 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated) {
       }
     }
     if (t.companion_id < 0) continue;
-    const auto c = std::find_if(measured.begin(), measured.end(),
-                                [&](std::size_t k) { return states_[k].track.id == t.companion_id; });
+    std::size_t c = 0;
+    while (c < states_.size() && states_[c].track.id != t.companion_id) ++c;
     // (Standing close by, the two are as likely one person tracked twice, sharing one blob.)
-    const bool stands_close = c != measured.end() && !walks(states_[*c]) &&
+    const bool stands_close = c < states_.size() && measured(c) && !walks(states_[c]) &&
                               s.companion_offset.norm() < params_.companion_standing_min_gap_m;
-    if (c == measured.end() || stands_close) {
-      t.companion_id = -1;  // the companion is hidden too, or stands close by: coast alone from here
+    if (c == states_.size() || stands_close) {
+      // The companion's track ended: coast alone from where it last placed it. Or it stands close
+      // by: as likely its duplicate, it coasts from where it was last seen.
+      t.companion_id = -1;
+      if (stands_close) s.placed_s = -std::numeric_limits<double>::infinity();
       continue;
     }
-    const TrackState_& companion = states_[*c];
+    const TrackState_& companion = states_[c];
     s.x.head<2>() = companion.x.head<2>() + s.companion_offset;
     s.x.tail<2>() = companion.x.tail<2>();
     s.P = companion.P;
+    if (measured(c)) s.placed_s = stamp_s;
   }
 }
 
@@ -373,7 +380,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     }
   }
 
-  if (params_.companion_max_gap_m > 0.0) FollowCompanions(updated);
+  if (params_.companion_max_gap_m > 0.0) FollowCompanions(updated, stamp_s);
 
   // Lifecycle of every existing track.
   std::vector<TrackState_> kept;
@@ -397,7 +404,10 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
         }
       } else {
         t.state = TrackState::kLost;
-        if (stamp_s - t.last_seen_s > MaxOcclusion(s)) {
+        // Following, it is bounded since it was seen; alone again (its companion's track ended), it
+        // coasts from where a measured companion last placed it.
+        const double lost_since = t.companion_id >= 0 ? t.last_seen_s : std::max(t.last_seen_s, s.placed_s);
+        if (stamp_s - lost_since > MaxOcclusion(s)) {
           ++deleted_;
           continue;
         }

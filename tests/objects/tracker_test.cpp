@@ -257,6 +257,28 @@ TEST(TrackerTest, HiddenWalkerWaitsWithItsCompanionWhenItStops) {
   EXPECT_EQ(not_waited.lost_frames, coasted.lost_frames);
 }
 
+TEST(TrackerTest, HiddenWalkerWalksOnWithItsCompanionWhenBothHide) {
+  // Two people walk side by side 0.6 m apart (the simulated scene's pair in single file); the far
+  // one is hidden from 1 s to 6 s, the near one too from 3.5 s to 5 s (both behind a parked car).
+  // The follower, placed beside its companion until 3.5 s, coasts on beside it and is placed again
+  // when the companion is seen; alone, it would be dropped 2 s after it was last seen.
+  const std::vector<Walker> walkers = {
+      {1, {-4.0, 0.0}, {1.2, 0.0}, 3.5, 5.0},
+      {2, {-4.0, 0.6}, {1.2, 0.0}, 1.0, 6.0},
+  };
+  const SceneResult followed = RunScene(walkers, 8.0);
+  EXPECT_EQ(followed.tracks_created, 2) << "the hidden walker's track must survive its companion hiding";
+  EXPECT_EQ(followed.score.id_switches, 0);
+  // Walker 2's 50 hidden frames and walker 1's 15, each at most one re-association frame short.
+  EXPECT_GE(followed.lost_frames, 50 + 15 - 2);
+  EXPECT_LT(followed.score.max_error_m, kMaxErrorM);
+  TrackerParams alone;
+  alone.companion_max_gap_m = 0.0;
+  const SceneResult coasted = RunScene(walkers, 8.0, 0.0, alone);
+  EXPECT_EQ(coasted.tracks_created, 3);
+  EXPECT_GT(coasted.score.misses, followed.score.misses + 15);
+}
+
 TEST(TrackerTest, MergedPedestriansBothSurviveAndSplit) {
   // Two walkers pass each other head-on 0.6 m apart: for ~0.6 s stereo sees one blob
   // (Fig. 4.16 bottom); both tracks must share it and come out with their own ids.

@@ -87,13 +87,16 @@ struct TrackerParams {
   /// each other: a pedestrian track lost while another pedestrian track within
   /// companion_max_gap_m is measured walking (at least companion_min_speed_mps) at nearly its
   /// velocity (within companion_max_speed_diff_mps) follows that companion at the offset it had
-  /// when lost, for up to companion_max_occlusion_s while the companion stays measured, instead
-  /// of coasting on its own velocity. 0 gap = off. While the companion stands still the follower
-  /// waits with it (people walking together stop together) when it was lost at least
-  /// companion_standing_min_gap_m from it; nearer, the two are as likely one person tracked twice
-  /// (two tracks sharing one blob), and it coasts alone. With the tandem split's partly seen far
-  /// walker, simulated scene at full resolution, seeds 1-5: pedestrians 0.942 / 0.859 -> 0.953 /
-  /// 0.895 (the far one of a pair in single file, hidden while both stand at the turning spot).
+  /// when lost, for up to companion_max_occlusion_s, instead of coasting on its own velocity.
+  /// 0 gap = off. While the companion stands still the follower waits with it (people walking
+  /// together stop together) when it was lost at least companion_standing_min_gap_m from it;
+  /// nearer, the two are as likely one person tracked twice (two tracks sharing one blob), and it
+  /// coasts alone. While the companion is hidden too, the follower walks on beside its coasting
+  /// track and is placed beside it again once it is seen; should the companion's track end, the
+  /// follower coasts alone, its occlusion limit counted from where a measured companion last
+  /// placed it. With the tandem split's partly seen far walker, simulated scene at full
+  /// resolution, seeds 1-5: pedestrians 0.942 / 0.859 -> 0.953 / 0.895 (the far one of a pair in
+  /// single file, hidden while both stand at the turning spot).
   double companion_max_gap_m = 1.6;
   double companion_min_speed_mps = 0.4;
   double companion_max_speed_diff_mps = 0.5;
