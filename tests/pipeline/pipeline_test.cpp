@@ -1174,41 +1174,51 @@ TEST(PipelineTest, MissesListEachFrameTheNarrowBayWasReportedFeasible) {
   EXPECT_NE(e.MissesText().find("log 1 frame 34 narrow bay 2"), std::string::npos) << e.MissesText();
 }
 
+// One frame of @p truths and @p detections (the vehicle at the origin) as an outputs log.
+void WriteOneFrameLog(const std::string& log, const std::vector<sim::GtBox>& truths,
+                      const std::vector<planning_iface::Obstacle>& detections) {
+  drivers::LogWriter writer(log);
+  sim::GroundTruth truth;
+  truth.stamp_ns = 1'000'000'000;
+  truth.objects = truths;
+  const auto truth_bytes = sim::Encode(truth);
+  writer.WriteRaw(sim::kGroundTruthChannel, truth.stamp_ns, truth_bytes.data(), truth_bytes.size());
+  planning_iface::ObstacleList list;
+  list.stamp_ns = truth.stamp_ns;
+  list.obstacles = detections;
+  const auto list_bytes = planning_iface::Encode(list);
+  writer.WriteRaw(planning_iface::kObstaclesChannel, list.stamp_ns, list_bytes.data(), list_bytes.size());
+}
+
+sim::GtBox TruthAt(int id, const std::string& class_name, double x, double y) {
+  sim::GtBox b;
+  b.id = id;
+  b.class_name = class_name;
+  b.center_m = Eigen::Vector3d(x, y, 0.75);
+  b.size_m = class_name == "car" ? Eigen::Vector3d(4.4, 1.8, 1.5) : Eigen::Vector3d(0.4, 0.5, 1.7);
+  return b;
+}
+
+planning_iface::Obstacle DetectionAt(const std::string& class_name, double x, double y) {
+  planning_iface::Obstacle o;
+  o.class_name = class_name;
+  o.center_m = Eigen::Vector3d(x, y, 0.75);
+  o.size_m = class_name == "car" ? Eigen::Vector3d(4.4, 1.8, 1.5) : Eigen::Vector3d(0.6, 0.4, 1.7);
+  o.num_points = 100;
+  return o;
+}
+
 // A car straddling the 15 m edge is scored as neither a false detection (its truth just outside)
 // nor a miss (its box just outside); what lies wholly inside is scored as before.
 TEST(PipelineTest, EvalSceneLeavesPairsAcrossTheRangesEdgeUnscored) {
   romo::test::ScratchDir dir;
   const std::string log = dir / "edge.lcmlog";
-  {
-    drivers::LogWriter writer(log);
-    sim::GroundTruth truth;
-    truth.stamp_ns = 1'000'000'000;
-    const auto car = [](int id, double x, double y) {
-      sim::GtBox b;
-      b.id = id;
-      b.class_name = "car";
-      b.center_m = Eigen::Vector3d(x, y, 0.75);
-      b.size_m = Eigen::Vector3d(4.4, 1.8, 1.5);
-      return b;
-    };
-    truth.objects = {car(1, 14.5, 0.0), car(2, 15.6, 3.0), car(3, 10.0, 0.0)};  // car 2 is 15.9 m away
-    const auto truth_bytes = sim::Encode(truth);
-    writer.WriteRaw(sim::kGroundTruthChannel, truth.stamp_ns, truth_bytes.data(), truth_bytes.size());
-    planning_iface::ObstacleList list;
-    list.stamp_ns = truth.stamp_ns;
-    for (const Eigen::Vector2d& at : {Eigen::Vector2d(15.3, 0.0),   // car 1's box, 15.3 m away
-                                      Eigen::Vector2d(14.6, 3.0),   // car 2's, 14.9 m away
-                                      Eigen::Vector2d(5.0, 5.0)}) {  // nothing there
-      planning_iface::Obstacle o;
-      o.class_name = "car";
-      o.center_m = Eigen::Vector3d(at.x(), at.y(), 0.75);
-      o.size_m = Eigen::Vector3d(4.4, 1.8, 1.5);
-      o.num_points = 100;
-      list.obstacles.push_back(o);
-    }
-    const auto list_bytes = planning_iface::Encode(list);
-    writer.WriteRaw(planning_iface::kObstaclesChannel, list.stamp_ns, list_bytes.data(), list_bytes.size());
-  }
+  WriteOneFrameLog(log,
+                   {TruthAt(1, "car", 14.5, 0.0), TruthAt(2, "car", 15.6, 3.0),  // car 2 is 15.9 m away
+                    TruthAt(3, "car", 10.0, 0.0)},
+                   {DetectionAt("car", 15.3, 0.0),    // car 1's box, 15.3 m away
+                    DetectionAt("car", 14.6, 3.0),    // car 2's, 14.9 m away
+                    DetectionAt("car", 5.0, 5.0)});  // nothing there
   const SceneEval e = EvaluateSceneLog(log);
   ASSERT_EQ(e.frames, 1);
   EXPECT_EQ(e.car.truths, 2);              // cars 1 and 3
@@ -1216,6 +1226,23 @@ TEST(PipelineTest, EvalSceneLeavesPairsAcrossTheRangesEdgeUnscored) {
   EXPECT_EQ(e.car.matched_truths, 1);      // car 1
   EXPECT_DOUBLE_EQ(e.car.precision(), 0.5);
   EXPECT_DOUBLE_EQ(e.car.recall(), 0.5);
+}
+
+// Two people 0.6 m apart, one box between them and one 0.4 m past the farther: nearest-first
+// would give the box between to the farther one and leave the nearer unmatched (the other box is
+// 1.0 m from it, past the 0.8 m gate); both are matched, as CLEAR-MOT matches.
+TEST(PipelineTest, EvalSceneMatchesTheMostPairsNotTheNearestFirst) {
+  romo::test::ScratchDir dir;
+  const std::string log = dir / "pair.lcmlog";
+  WriteOneFrameLog(log, {TruthAt(11, "pedestrian", 5.0, 0.0), TruthAt(12, "pedestrian", 5.6, 0.0)},
+                   {DetectionAt("pedestrian", 5.31, 0.0), DetectionAt("pedestrian", 6.0, 0.0)});
+  const SceneEval e = EvaluateSceneLog(log);
+  ASSERT_EQ(e.frames, 1);
+  EXPECT_EQ(e.pedestrian.matched_truths, 2);
+  EXPECT_DOUBLE_EQ(e.pedestrian.precision(), 1.0);
+  EXPECT_DOUBLE_EQ(e.pedestrian.recall(), 1.0);
+  // The boxes 0.31 and 0.4 m off, the upper middle of two (the nearest-first pair was 0.29 m).
+  EXPECT_NEAR(e.pedestrian.center_err_m_median, 0.4, 1e-6);
 }
 
 // Several runs (seeds) scored as one: what each run counts adds up, and the lists name the run.

@@ -11,6 +11,7 @@
 #include "romo/core/check.hpp"
 #include "romo/core/statistics.hpp"
 #include "romo/drivers/recording.hpp"
+#include "romo/objects/hungarian.hpp"
 #include "romo/objects/prediction_log.hpp"
 #include "romo/objects/tracking_eval.hpp"
 #include "romo/planning_iface/messages.hpp"
@@ -28,23 +29,27 @@ struct Frame {
   std::vector<objects::PedestrianPrediction> predictions;
 };
 
-// Greedy one-to-one matching by distance (small scenes: a handful of objects per class).
+// One-to-one matching of the most pairs within @p max_m, then the least summed distance (the
+// CLEAR-MOT matching IdSwitchCounter uses: greedy nearest-first can leave two close people with
+// one match where two exist).
 std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth,
                                        const std::vector<Eigen::Vector2d>& det, double max_m) {
-  std::vector<std::tuple<double, int, int>> pairs;
+  if (truth.empty() || det.empty()) return {};
+  // A pair past the gate costs more than any assignment's gated pairs together, so the fewest
+  // such pairs are taken first, and the distances of the rest still count exactly.
+  const double beyond_gate = max_m * static_cast<double>(std::min(truth.size(), det.size()) + 1);
+  Eigen::MatrixXd cost(static_cast<Eigen::Index>(truth.size()), static_cast<Eigen::Index>(det.size()));
   for (std::size_t i = 0; i < truth.size(); ++i) {
     for (std::size_t j = 0; j < det.size(); ++j) {
       const double d = (truth[i] - det[j]).norm();
-      if (d <= max_m) pairs.emplace_back(d, static_cast<int>(i), static_cast<int>(j));
+      cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d <= max_m ? d : beyond_gate;
     }
   }
-  std::sort(pairs.begin(), pairs.end());
-  std::vector<bool> ti(truth.size()), dj(det.size());
+  const objects::Assignment a = objects::SolveAssignment(cost);
   std::vector<std::pair<int, int>> out;
-  for (const auto& [d, i, j] : pairs) {
-    if (ti[i] || dj[j]) continue;
-    ti[i] = dj[j] = true;
-    out.emplace_back(i, j);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const int j = a.row_to_col[i];
+    if (j >= 0 && cost(static_cast<Eigen::Index>(i), j) <= max_m) out.emplace_back(static_cast<int>(i), j);
   }
   return out;
 }
