@@ -239,7 +239,7 @@ TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   EXPECT_GE(e.car.precision(), 0.95);
   EXPECT_GE(e.car.recall(), 0.92);
   EXPECT_GE(e.pedestrian.precision(), 0.95);
-  EXPECT_GE(e.pedestrian.recall(), 0.88);
+  EXPECT_GE(e.pedestrian.recall(), 0.91);  // 0.934 (183/196) since the follower walks on with its hidden companion
 }
 
 }  // namespace
