@@ -125,7 +125,7 @@ class Tracker::Impl {
   void KalmanUpdate(TrackState_* s, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
   bool MayHoldSeveral(const Detection& d) const;
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
-  double MaxOcclusion(const TrackState_& s) const;
+  bool OccludedTooLong(const TrackState_& s, double stamp_s) const;
   void FollowCompanions(const std::vector<char>& updated, double stamp_s);
   void Observe(TrackState_* s, const Detection& d, double stamp_s) const;
 };
@@ -177,14 +177,17 @@ Eigen::Matrix2d Tracker::Impl::MeasurementCov(const Detection& d) const {
   return r * spread.asDiagonal() * r.transpose();
 }
 
-double Tracker::Impl::MaxOcclusion(const TrackState_& s) const {
+bool Tracker::Impl::OccludedTooLong(const TrackState_& s, double stamp_s) const {
   double limit = params_.max_occlusion_s;
   if (s.track.class_index >= 0) {
     limit = std::max(limit, atlas_.classes()[static_cast<std::size_t>(s.track.class_index)].max_occlusion_s);
   }
-  // Placed by its companion this frame (FollowCompanions): it is where the companion is seen.
-  if (s.track.companion_id >= 0) limit = std::max(limit, params_.companion_max_occlusion_s);
-  return limit;
+  // Placed by its companion this frame (FollowCompanions): bounded since it was seen itself. Alone
+  // again (its companion's track ended), it coasts from where a measured companion last placed it.
+  if (s.track.companion_id >= 0) {
+    return stamp_s - s.track.last_seen_s > std::max(limit, params_.companion_max_occlusion_s);
+  }
+  return stamp_s - std::max(s.track.last_seen_s, s.placed_s) > limit;
 }
 
 void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, double stamp_s) {
@@ -404,10 +407,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
         }
       } else {
         t.state = TrackState::kLost;
-        // Following, it is bounded since it was seen; alone again (its companion's track ended), it
-        // coasts from where a measured companion last placed it.
-        const double lost_since = t.companion_id >= 0 ? t.last_seen_s : std::max(t.last_seen_s, s.placed_s);
-        if (stamp_s - lost_since > MaxOcclusion(s)) {
+        if (OccludedTooLong(s, stamp_s)) {
           ++deleted_;
           continue;
         }
