@@ -131,6 +131,23 @@ Assignment SolveAssignment(const Eigen::MatrixXd& cost) {
   return Finish(cost, row_to_col);
 }
 
+std::vector<std::pair<int, int>> MatchWithinGate(const std::vector<Eigen::Vector2d>& a,
+                                                 const std::vector<Eigen::Vector2d>& b, double gate_m) {
+  Eigen::MatrixXd cost(static_cast<Eigen::Index>(a.size()), static_cast<Eigen::Index>(b.size()));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      const double d = (a[i] - b[j]).norm();
+      cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d <= gate_m ? d : kForbiddenCost;
+    }
+  }
+  const Assignment assignment = SolveAssignment(cost);
+  std::vector<std::pair<int, int>> pairs;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (assignment.row_to_col[i] >= 0) pairs.emplace_back(static_cast<int>(i), assignment.row_to_col[i]);
+  }
+  return pairs;
+}
+
 Assignment SolveAssignmentBruteForce(const Eigen::MatrixXd& cost) {
   CheckCosts(cost);
   ROMO_THROW_UNLESS(cost.rows() <= 8 && cost.cols() <= 8);

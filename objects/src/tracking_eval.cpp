@@ -45,21 +45,12 @@ void IdSwitchCounter::AddFrame(const std::vector<IdPosition>& ground_truth,
   for (std::size_t t = 0; t < tracks.size(); ++t) {
     if (!track_taken[t]) free_tracks.push_back(static_cast<int>(t));
   }
-  Eigen::MatrixXd cost(static_cast<Eigen::Index>(free_objects.size()),
-                       static_cast<Eigen::Index>(free_tracks.size()));
-  for (std::size_t g = 0; g < free_objects.size(); ++g) {
-    for (std::size_t t = 0; t < free_tracks.size(); ++t) {
-      const double d = (ground_truth[static_cast<std::size_t>(free_objects[g])].xy_m -
-                        tracks[static_cast<std::size_t>(free_tracks[t])].xy_m).norm();
-      cost(static_cast<Eigen::Index>(g), static_cast<Eigen::Index>(t)) =
-          d <= max_match_distance_m_ ? d : kForbiddenCost;
-    }
-  }
-  const Assignment a = SolveAssignment(cost);
-  for (std::size_t g = 0; g < free_objects.size(); ++g) {
-    if (a.row_to_col[g] >= 0) {
-      match[static_cast<std::size_t>(free_objects[g])] = free_tracks[static_cast<std::size_t>(a.row_to_col[g])];
-    }
+  std::vector<Eigen::Vector2d> free_object_xy, free_track_xy;
+  for (const int g : free_objects) free_object_xy.push_back(ground_truth[static_cast<std::size_t>(g)].xy_m);
+  for (const int t : free_tracks) free_track_xy.push_back(tracks[static_cast<std::size_t>(t)].xy_m);
+  for (const auto& [g, t] : MatchWithinGate(free_object_xy, free_track_xy, max_match_distance_m_)) {
+    match[static_cast<std::size_t>(free_objects[static_cast<std::size_t>(g)])] =
+        free_tracks[static_cast<std::size_t>(t)];
   }
   std::int64_t matched_tracks = 0;
   for (std::size_t g = 0; g < ground_truth.size(); ++g) {

@@ -55,6 +55,18 @@ TEST(HungarianTest, KnownThreeByThreeOptimum) {
   EXPECT_DOUBLE_EQ(a.total_cost, 5.0);
 }
 
+// Greedy nearest-first would pair a1 with b0 (0.4 m) and leave a0 without a partner within the
+// gate; the gated matching takes both pairs, then the least summed distance, never one past it.
+TEST(HungarianTest, MatchWithinGateTakesTheMostPairsThenTheLeastDistance) {
+  const std::vector<Eigen::Vector2d> a{{0.0, 0.0}, {1.0, 0.0}, {9.0, 0.0}};
+  const std::vector<Eigen::Vector2d> b{{1.7, 0.0}, {0.6, 0.0}};
+  EXPECT_EQ(MatchWithinGate(a, b, 0.75), (std::vector<std::pair<int, int>>{{0, 1}, {1, 0}}));
+  EXPECT_EQ(MatchWithinGate(a, b, 0.65), (std::vector<std::pair<int, int>>{{1, 1}}));
+  const std::vector<Eigen::Vector2d> near_b{{1.1, 0.0}, {0.1, 0.0}};
+  EXPECT_EQ(MatchWithinGate(a, near_b, 1.5), (std::vector<std::pair<int, int>>{{0, 1}, {1, 0}}));
+  EXPECT_TRUE(MatchWithinGate(a, {}, 1.0).empty());
+}
+
 TEST(HungarianTest, RejectsNaNCost) {
   Eigen::MatrixXd cost = Eigen::MatrixXd::Ones(2, 2);
   cost(1, 0) = std::nan("");

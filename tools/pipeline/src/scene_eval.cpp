@@ -29,31 +29,6 @@ struct Frame {
   std::vector<objects::PedestrianPrediction> predictions;
 };
 
-// One-to-one matching of the most pairs within @p max_m, then the least summed distance (the
-// CLEAR-MOT matching IdSwitchCounter uses: greedy nearest-first can leave two close people with
-// one match where two exist).
-std::vector<std::pair<int, int>> Match(const std::vector<Eigen::Vector2d>& truth,
-                                       const std::vector<Eigen::Vector2d>& det, double max_m) {
-  if (truth.empty() || det.empty()) return {};
-  // A pair past the gate costs more than any assignment's gated pairs together, so the fewest
-  // such pairs are taken first, and the distances of the rest still count exactly.
-  const double beyond_gate = max_m * static_cast<double>(std::min(truth.size(), det.size()) + 1);
-  Eigen::MatrixXd cost(static_cast<Eigen::Index>(truth.size()), static_cast<Eigen::Index>(det.size()));
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    for (std::size_t j = 0; j < det.size(); ++j) {
-      const double d = (truth[i] - det[j]).norm();
-      cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d <= max_m ? d : beyond_gate;
-    }
-  }
-  const objects::Assignment a = objects::SolveAssignment(cost);
-  std::vector<std::pair<int, int>> out;
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    const int j = a.row_to_col[i];
-    if (j >= 0 && cost(static_cast<Eigen::Index>(i), j) <= max_m) out.emplace_back(static_cast<int>(i), j);
-  }
-  return out;
-}
-
 // Keeps the entries of @p v whose @p new_index is >= 0 (ascending), at that index.
 template <class T>
 void Compact(std::vector<T>* v, const std::vector<int>& new_index) {
@@ -218,7 +193,7 @@ void Scorer::Add(const std::string& log_path, int log_index) {
         det_track.push_back(o.track_id);
         det_box.push_back(&o);
       }
-      std::vector<std::pair<int, int>> m = Match(truth, det, gate);
+      std::vector<std::pair<int, int>> m = objects::MatchWithinGate(truth, det, gate);
       {
         // Scored: the truths within range, the detections matched to them, and the unmatched
         // detections within range.

@@ -1,5 +1,6 @@
 #pragma once
 /// Optimal assignment (Hungarian method, shortest augmenting paths with potentials, O(n^2 m)).
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -22,6 +23,11 @@ struct Assignment {
 /// forbidden pairs are removed (so gating never makes the solver trade two good pairs for one).
 /// @throws romo::Error when a cost is NaN or negative infinity.
 Assignment SolveAssignment(const Eigen::MatrixXd& cost);
+
+/// One-to-one pairs (index into @p a, index into @p b) at most @p gate_m apart: the most such
+/// pairs, then the least summed distance (CLEAR-MOT matching), ascending by index into @p a.
+std::vector<std::pair<int, int>> MatchWithinGate(const std::vector<Eigen::Vector2d>& a,
+                                                 const std::vector<Eigen::Vector2d>& b, double gate_m);
 
 /// Reference: tries every assignment (rows, cols <= 8). Same contract as SolveAssignment.
 Assignment SolveAssignmentBruteForce(const Eigen::MatrixXd& cost);
