@@ -44,16 +44,17 @@ PointCloud MakeGround(const Ground& g, const BayStrip& strip, const Eigen::Isome
   std::uniform_real_distribution<float> grey_noise(-g.noise, g.noise);
   const Eigen::Vector2d lateral(-strip.depth_axis.y(), strip.depth_axis.x());
   const double area = (strip.rear_m - strip.front_m + 4.0) * 5.0;
-  PointCloud cloud;
   const int n = static_cast<int>(area * g.density_per_m2);
+  PointCloud cloud;  // filled in place: PushBack per point is quadratic under ASan
+  cloud.Resize(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
     const double s = s_dist(rng), t = t_dist(rng);
     float grey = g.asphalt;
     if (s >= g.line_from && s <= g.line_to) grey = g.paint;
     if (s >= g.surface_from) grey = g.surface;
     const Eigen::Vector2d xy = strip.center_m + s * strip.depth_axis + t * lateral;
-    cloud.PushBack((T_cloud_frame * Eigen::Vector3d(xy.x(), xy.y(), 0.0)).cast<float>(), 0.f,
-                   grey + grey_noise(rng));
+    cloud.xyz.col(k) = (T_cloud_frame * Eigen::Vector3d(xy.x(), xy.y(), 0.0)).cast<float>();
+    cloud.intensity[static_cast<std::size_t>(k)] = grey + grey_noise(rng);
     ground->push_back(k);
   }
   return cloud;

@@ -47,14 +47,15 @@ PointCloud MakeGround(const Row& row, double yaw, std::vector<int>* ground, unsi
   std::uniform_real_distribution<float> grey_noise(-row.noise, row.noise);
   const auto n = static_cast<int>(row.density_per_m2 * 13.0 * 20.0);
   const double c = std::cos(yaw), s = std::sin(yaw);
-  PointCloud cloud;
-  auto add = [&](double u, double v) {
-    const float grey = (OnPaint(row, u, v) ? row.paint : row.asphalt) + grey_noise(rng);
-    ground->push_back(static_cast<int>(cloud.size()));
-    cloud.PushBack(Eigen::Vector3f(static_cast<float>(c * u - s * v), static_cast<float>(s * u + c * v), 0.f), 0.02f,
-                   grey);
-  };
-  for (int i = 0; i < n; ++i) add(u_of(rng), v_of(rng));
+  PointCloud cloud;  // filled in place: PushBack per point is quadratic under ASan
+  cloud.Resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double u = u_of(rng), v = v_of(rng);
+    cloud.xyz.col(i) = Eigen::Vector3f(static_cast<float>(c * u - s * v), static_cast<float>(s * u + c * v), 0.f);
+    cloud.sigma_z_m[static_cast<std::size_t>(i)] = 0.02f;
+    cloud.intensity[static_cast<std::size_t>(i)] = (OnPaint(row, u, v) ? row.paint : row.asphalt) + grey_noise(rng);
+    ground->push_back(i);
+  }
   return cloud;
 }
 

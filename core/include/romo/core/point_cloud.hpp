@@ -25,7 +25,9 @@ struct PointCloud {
   void Reserve(std::size_t n);
   /// Resizes all channels to @p n points (new entries are uninitialised positions, zero extras).
   void Resize(std::size_t n);
-  /// Appends one point.
+  /// Appends one point: O(size()) per call, since an Eigen matrix keeps no spare capacity (a loop
+  /// of PushBack is quadratic wherever realloc cannot grow in place, e.g. under ASan). For many
+  /// points, Resize once and fill the channels.
   void PushBack(const Eigen::Vector3f& p, float sigma_z_m_value = 0.f, float intensity_value = 0.f);
   /// Appends all points of @p other.
   void Append(const PointCloud& other);
