@@ -41,6 +41,7 @@ struct TrackState_ {
   Eigen::Vector2d companion_offset = Eigen::Vector2d::Zero();  // from the companion, when lost
   // Last placed by a measured companion: as good as seen then, so its own coast starts there.
   double placed_s = -std::numeric_limits<double>::infinity();
+  bool duplicate = false;  // a follower where another track measures someone: that person (ends)
   std::vector<int> votes;         // per Atlas class
   std::vector<double> vote_score;  // summed scores per class
 };
@@ -125,8 +126,11 @@ class Tracker::Impl {
   void KalmanUpdate(TrackState_* s, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
   bool MayHoldSeveral(const Detection& d) const;
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
+  bool Glimpse(const TrackState_& s, const Detection& d) const;
+  bool WithinCompanionGap(const TrackState_& s, const Eigen::Vector2d& xy_m) const;
+  Eigen::Matrix2d GlimpseCov() const;
   bool OccludedTooLong(const TrackState_& s, double stamp_s) const;
-  void FollowCompanions(const std::vector<char>& updated, double stamp_s);
+  void FollowCompanions(const std::vector<char>& updated, const std::vector<char>& glimpsed, double stamp_s);
   void Observe(TrackState_* s, const Detection& d, double stamp_s) const;
 };
 
@@ -177,6 +181,25 @@ Eigen::Matrix2d Tracker::Impl::MeasurementCov(const Detection& d) const {
   return r * spread.asDiagonal() * r.transpose();
 }
 
+bool Tracker::Impl::Glimpse(const TrackState_& s, const Detection& d) const {
+  if (!params_.companion_glimpses || s.track.companion_id < 0) return false;
+  const ObjectClass& ped = atlas_.classes()[static_cast<std::size_t>(pedestrian_)];
+  return d.classification.class_index != pedestrian_ || d.width_m < ped.width.mean_m - ped.width.sigma_m;
+}
+
+bool Tracker::Impl::WithinCompanionGap(const TrackState_& s, const Eigen::Vector2d& xy_m) const {
+  for (const TrackState_& c : states_) {
+    if (c.track.id == s.track.companion_id) return (xy_m - c.x.head<2>()).norm() <= params_.companion_max_gap_m;
+  }
+  return true;
+}
+
+Eigen::Matrix2d Tracker::Impl::GlimpseCov() const {
+  const ObjectClass& ped = atlas_.classes()[static_cast<std::size_t>(pedestrian_)];
+  const double s2 = params_.measurement_sigma_m * params_.measurement_sigma_m;
+  return Eigen::Matrix2d::Identity() * (ped.length.max_m * ped.length.max_m / 12.0 + s2);
+}
+
 bool Tracker::Impl::OccludedTooLong(const TrackState_& s, double stamp_s) const {
   double limit = params_.max_occlusion_s;
   if (s.track.class_index >= 0) {
@@ -190,7 +213,8 @@ bool Tracker::Impl::OccludedTooLong(const TrackState_& s, double stamp_s) const 
   return stamp_s - std::max(s.track.last_seen_s, s.placed_s) > limit;
 }
 
-void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, double stamp_s) {
+void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, const std::vector<char>& glimpsed,
+                                     double stamp_s) {
   // Companions: pedestrian tracks measured alone now. A companion is taken only while walking (two
   // people standing near each other need not be together), then followed while it stands too:
   // people walking together stop together, and the hidden one waits behind the one seen. Hidden
@@ -204,6 +228,18 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, double st
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
     Track& t = s.track;
+    if (glimpsed[i]) {
+      // Moved by the glimpse, it walks on with its companion from there.
+      std::size_t c = 0;
+      while (c < states_.size() && states_[c].track.id != t.companion_id) ++c;
+      if (c == states_.size()) {
+        t.companion_id = -1;
+      } else {
+        s.x.tail<2>() = states_[c].x.tail<2>();
+        s.companion_offset = s.x.head<2>() - states_[c].x.head<2>();
+      }
+      continue;
+    }
     if (updated[i] || t.state == TrackState::kTentative || t.class_index != pedestrian_) {
       t.companion_id = -1;
       continue;
@@ -240,6 +276,16 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, double st
     s.x.tail<2>() = companion.x.tail<2>();
     s.P = companion.P;
     if (measured(c)) s.placed_s = stamp_s;
+  }
+  // A follower nearer another person measured now than two people stand apart is that person,
+  // tracked twice.
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    TrackState_& s = states_[i];
+    if (s.track.companion_id < 0) continue;
+    for (std::size_t k = 0; k < states_.size(); ++k) {
+      if (k == i || glimpsed[k] || !measured(k) || states_[k].track.id == s.track.companion_id) continue;
+      if ((s.x.head<2>() - states_[k].x.head<2>()).norm() < params_.companion_standing_min_gap_m) s.duplicate = true;
+    }
   }
 }
 
@@ -325,7 +371,10 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     for (std::size_t c = 0; c < column_detection.size(); ++c) {
       const int j = column_detection[c];
       double value = kForbiddenCost;
-      if (column_copy[c] == 0 || pedestrian_track) {
+      // People walking together stay together: a glimpse farther from the companion is someone else.
+      const bool allowed = !Glimpse(s, detections[static_cast<std::size_t>(j)]) ||
+                           WithinCompanionGap(s, detections[static_cast<std::size_t>(j)].xy_m);
+      if (allowed && (column_copy[c] == 0 || pedestrian_track)) {
         const Eigen::Matrix2d S = h * s.P * h.transpose() + R[static_cast<std::size_t>(j)];
         const Eigen::Vector2d y = detections[static_cast<std::size_t>(j)].xy_m - h * s.x;
         const double d2 = y.dot(S.ldlt().solve(y));
@@ -343,12 +392,14 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     const int c = assignment.row_to_col[i];
     if (c >= 0) members[static_cast<std::size_t>(column_detection[static_cast<std::size_t>(c)])].push_back(static_cast<int>(i));
   }
-  std::vector<char> updated(states_.size(), 0);
+  std::vector<char> updated(states_.size(), 0), glimpsed(states_.size(), 0);
   for (std::size_t j = 0; j < detections.size(); ++j) {
     const Detection& d = detections[j];
     if (members[j].size() == 1) {
       TrackState_& s = states_[static_cast<std::size_t>(members[j][0])];
-      KalmanUpdate(&s, d.xy_m, R[j]);
+      const bool glimpse = Glimpse(s, d);
+      glimpsed[static_cast<std::size_t>(members[j][0])] = glimpse ? 1 : 0;
+      KalmanUpdate(&s, d.xy_m, glimpse ? GlimpseCov() : R[j]);
       Observe(&s, d, stamp_s);
       s.track.merged = false;
       s.track.detection_index = static_cast<int>(j);
@@ -383,7 +434,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
     }
   }
 
-  if (params_.companion_max_gap_m > 0.0) FollowCompanions(updated, stamp_s);
+  if (params_.companion_max_gap_m > 0.0) FollowCompanions(updated, glimpsed, stamp_s);
 
   // Lifecycle of every existing track.
   std::vector<TrackState_> kept;
@@ -391,6 +442,10 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
   for (std::size_t i = 0; i < states_.size(); ++i) {
     TrackState_& s = states_[i];
     Track& t = s.track;
+    if (s.duplicate) {
+      ++deleted_;
+      continue;
+    }
     if (updated[i]) {
       ++t.hits;
       s.misses = 0;

@@ -198,12 +198,14 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // the far one of two people one behind the other, seen as a sliver beside the near one, is a
   // person too (tandem_far_partly_seen): pedestrian P 0.889 -> 0.890, R 0.813 -> 0.817, centre
   // 0.274 -> 0.270 m (at full resolution, seeds 1-5 with the tracker's standing companions:
-  // pedestrians 0.942 / 0.859 -> 0.953 / 0.895).
+  // pedestrians 0.942 / 0.859 -> 0.953 / 0.895). Session 33: a hidden walker's follower glimpsed
+  // keeps following (TrackerParams::companion_glimpses), one near another person seen ends:
+  // pedestrian P 0.889 -> 0.893, R 0.819 -> 0.829 (hidden 0.48 -> 0.54), car R 0.859 -> 0.862.
   EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
   EXPECT_GE(mean.ped_p, 0.87);
-  EXPECT_GE(mean.ped_r, 0.79);
+  EXPECT_GE(mean.ped_r, 0.80);
   EXPECT_GE(mean.ped_visible_r, 0.84);
   EXPECT_LE(mean.centre_m, 0.285);
   EXPECT_LE(mean.car_yaw_deg, 2.5);
@@ -213,7 +215,7 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // of seeds; seed 3's cars 0.075, seed 5's 0.435): the largest share of recall left (hidden car
   // sightings are 14 % of all, 151 of the 524 car misses of seeds 1-5).
   EXPECT_GE(mean.car_hidden_r, 0.70);  // 0.33 since session 20, 0.47 since 22, 0.76 since 25, 0.73 since 28
-  EXPECT_GE(mean.ped_hidden_r, 0.40);
+  EXPECT_GE(mean.ped_hidden_r, 0.48);  // 0.54 since session 33
 }
 
 // The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo

@@ -91,7 +91,8 @@ struct TrackerParams {
   /// 0 gap = off. While the companion stands still the follower waits with it (people walking
   /// together stop together) when it was lost at least companion_standing_min_gap_m from it;
   /// nearer, the two are as likely one person tracked twice (two tracks sharing one blob), and it
-  /// coasts alone. While the companion is hidden too, the follower walks on beside its coasting
+  /// coasts alone. A follower nearer than that to another person measured now is that person,
+  /// tracked twice, and ends. While the companion is hidden too, the follower walks on beside its coasting
   /// track and is placed beside it again once it is seen; should the companion's track end, the
   /// follower coasts alone, its occlusion limit counted from where a measured companion last
   /// placed it. With the tandem split's partly seen far walker, simulated scene at full
@@ -102,6 +103,14 @@ struct TrackerParams {
   double companion_max_speed_diff_mps = 0.5;
   double companion_max_occlusion_s = 8.0;
   double companion_standing_min_gap_m = 0.8;
+  /// A follower glimpsed (a detection that is no whole person: of another class, or thinner than
+  /// a person's footprint, Atlas width mean - sigma: a sliver beside the one in front, legs below
+  /// a bonnet) keeps following: the glimpse moves it as a position anywhere within a person's
+  /// largest footprint (Atlas length max), and it keeps its companion's velocity. A glimpse's
+  /// centre is off by which part shows (0.3-1.0 m for slivers bridged by stereo to the one in
+  /// front), so a full update took a velocity error of a metre a second from it and broke the
+  /// pair. A glimpse farther than companion_max_gap_m from the companion is someone else's.
+  bool companion_glimpses = true;
   PredictorParams predictor;           ///< path prediction for predict_path classes
   /// @throws romo::Error naming the field and value.
   void Validate() const;
