@@ -221,11 +221,12 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
 // The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo
 // work), seed 1 only to keep CI short. Here more of the targets are met, and asserted:
 // car and pedestrian precision >= 0.95, box centre within 0.2 m, the bay found in every frame it
-// is fully visible; the others are floors a little under seed 1's figures (car P 0.983 R 0.947,
+// is fully visible; the others are floors a little under seed 1's figures (car P 0.983 R 0.964,
 // pedestrian P 0.989 R 0.908, centre 0.186 m, slot 32/32 at 0.056 m; car recall was 0.665 before
 // parked cars were placed by their row's paint, session 25; pedestrians 0.955 / 0.760 before boxes
 // stood on the ground, session 28, 0.982 / 0.857 before the far one of a pair in single file was
-// kept from a sliver and a hidden walker waited with its companion, session 30).
+// kept from a sliver and a hidden walker waited with its companion, session 30; car recall 0.947
+// before a car's end read as a cyclist at the row's front was placed as a car, session 33).
 TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   romo::test::ScratchDir dir;
   const auto run = romo::test::RunRomo("run --no-pictures --scale 1 --seed 1 --out " + dir.path());
@@ -239,7 +240,7 @@ TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
   EXPECT_LE(e.slot_yaw_err_deg, 3.0);
   EXPECT_LE(e.box_center_err_m_median, 0.2);
   EXPECT_GE(e.car.precision(), 0.95);
-  EXPECT_GE(e.car.recall(), 0.92);
+  EXPECT_GE(e.car.recall(), 0.94);
   EXPECT_GE(e.pedestrian.precision(), 0.95);
   EXPECT_GE(e.pedestrian.recall(), 0.91);  // 0.934 (183/196) since the follower walks on with its hidden companion
 }

@@ -321,6 +321,30 @@ TEST(PipelineTest, APartialViewInsideARememberedParkedCarTakesItsFootprint) {
   EXPECT_NEAR(preferred[0].size_m.y(), 1.8, 2 * kBoxCentreTolM);
 }
 
+TEST(PipelineTest, TwoCarsMeasuredInsideOneRememberedFootprintKeepTheirOwnBoxes) {
+  // The van seen whole and remembered; then a gap opens in its middle (x 3.3-4.7: a wrong memory
+  // across two neighbours' ends, seen apart now), leaving two parts inside its footprint, both
+  // within parked_prefer_max_range_m.
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  Pipeline pipe(calibration, PipelineParams{});
+  std::int64_t t = 1'000'000'000;
+  const float near_x = 1.0f;
+  SeeTheVanWhole(pipe, near_x, &t);
+  RigInput apart = ParkedVanScene(t, near_x + 6.0f, near_x);
+  DropPoints(&apart.cloud, [](const Eigen::Vector3f& p) { return p.z() > 0.1f && p.x() > 3.3f && p.x() < 4.7f; });
+  const FrameResult r = pipe.ProcessClouds(t, 4, {apart}, std::nullopt, std::nullopt);
+  std::vector<planning_iface::Obstacle> measured;
+  for (const auto& o : r.obstacles.obstacles) {
+    if (o.num_points > 0 && o.center_m.x() > 0.0 && std::abs(o.center_m.y()) < 2.0) measured.push_back(o);
+  }
+  ASSERT_EQ(measured.size(), 2u);
+  // Each part keeps its own box: their centres lie on either side of the gap, not both at the van's.
+  const double lo = std::min(measured[0].center_m.x(), measured[1].center_m.x());
+  const double hi = std::max(measured[0].center_m.x(), measured[1].center_m.x());
+  EXPECT_LT(lo, 3.3);
+  EXPECT_GT(hi, 4.7);
+}
+
 // The van's remembered obstacle (num_points 0) once it is out of view, after it was seen whole and
 // then less of it each second down to its first 2.5 m (the field of view's edge cutting it, as
 // when the vehicle drives past): beyond parked_prefer_max_range_m, so the cut views keep their own
@@ -611,6 +635,59 @@ TEST(PipelineTest, ACarsFrontAtARowsPaintedFrontIsACarAlongTheBays) {
   const auto piece_again = near(unused, {8.35, -4.1}, 0.3);
   ASSERT_TRUE(piece_again.has_value());
   EXPECT_EQ(piece_again->class_name, "unknown");
+}
+
+// The front rig's cloud: a row running along the vehicle's heading, its painted front line at
+// y 3 m, and a car's end at its front seen edge-on from 8 to 9.75 m ahead (1.75 m along the row,
+// smeared 0.95 m into the bay, 1.55 m tall: the simulated scene's car 101, seed 4, frames 26-32,
+// 1.75 x 0.8-1.0 x 1.56 m), the ground behind it unseen. It is as long and wide as a bicycle.
+RigInput CarEndSeenEdgeOnAtARowsFront() {
+  RigInput in = SyntheticRig(1, 1000);  // ground only
+  in.rig_id = 0;
+  DropPoints(&in.cloud, [](const Eigen::Vector3f& p) {
+    return p.x() >= 7.9f && p.x() <= 9.9f && p.y() >= 3.05f && p.y() <= 8.f;
+  });
+  for (float x = 0.f; x <= 12.f; x += 0.05f) {
+    for (float y = 2.96f; y <= 3.041f; y += 0.04f) in.cloud.PushBack({x, y, 0.f}, 0.01f, 250.f);
+  }
+  for (float x = 8.f; x <= 9.75f; x += 0.03f) {
+    for (float y = 3.1f; y <= 4.05f; y += 0.05f) {
+      for (float z = 0.05f; z <= 1.55f; z += 0.03f) in.cloud.PushBack({x, y, z}, 0.01f, 50.f);
+    }
+  }
+  return in;
+}
+
+TEST(PipelineTest, ACarsEndSeenEdgeOnAtARowsFrontIsACarNotACyclist) {
+  const auto calibration = drivers::Calibration::Load(drivers::SampleCalibrationPath());
+  auto nearest = [](const FrameResult& r, const Eigen::Vector2d& xy) {
+    std::optional<planning_iface::Obstacle> found;
+    for (const auto& o : r.obstacles.obstacles) {
+      if (o.num_points > 0 && (!found || (o.center_m.head<2>() - xy).norm() < (found->center_m.head<2>() - xy).norm())) {
+        found = o;
+      }
+    }
+    return found;
+  };
+  const FrameResult r = Pipeline(calibration, PipelineParams{})
+                            .ProcessClouds(1000, 1, {CarEndSeenEdgeOnAtARowsFront()}, std::nullopt, std::nullopt);
+  // The face's middle along the row (x 8.875) and its front (y 3.1) plus half the Atlas car's
+  // mean length (4.4 m): y 5.3. Tolerance: the points' spacing and the line's fit, as above.
+  const auto car = nearest(r, {8.875, 5.3});
+  ASSERT_TRUE(car.has_value());
+  EXPECT_EQ(car->class_name, "car");
+  EXPECT_NEAR(car->center_m.x(), 8.875, 0.1);
+  EXPECT_NEAR(car->center_m.y(), 5.3, 0.1);
+  EXPECT_NEAR(std::abs(std::cos(car->yaw_rad)), 0.0, std::sin(1.0 * 3.14159265 / 180.0)) << "along the bays";
+  // Without the row's reading it is what its shape says from the camera: a cyclist (the case
+  // this guards), not a car.
+  PipelineParams off;
+  off.bays_from_paint = false;
+  const FrameResult bare =
+      Pipeline(calibration, off).ProcessClouds(1000, 1, {CarEndSeenEdgeOnAtARowsFront()}, std::nullopt, std::nullopt);
+  const auto rider = nearest(bare, {8.875, 3.6});
+  ASSERT_TRUE(rider.has_value());
+  EXPECT_EQ(rider->class_name, "cyclist");
 }
 
 TEST(PipelineTest, TwoPeopleOneBehindTheOtherAreSplitIntoTwoPedestrians) {

@@ -489,8 +489,9 @@ class Pipeline::Impl {
     if (params.parked_prefer_fraction > 1.0 || parked.empty()) return;
     const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
     const double m = params.parked_footprint_margin_m;
+    std::vector<int> taken(detections->size(), -1);  // the remembered car each detection lies in
     for (std::size_t i = 0; i < detections->size(); ++i) {
-      objects::Detection& d = (*detections)[i];
+      const objects::Detection& d = (*detections)[i];
       // (the blob's nearest point last: the one test that walks its points)
       if (d.classification.class_index != car_class ||
           std::any_of(parked.begin(), parked.end(), [&](const auto& entry) {
@@ -504,16 +505,25 @@ class Pipeline::Impl {
         const int inside = PointsInsideFootprint(r.cloud, r.blobs[i], xy, car.yaw_rad - r.ego_world.yaw_rad,
                                                  0.5 * car.length_m + m, 0.5 * car.width_m + m);
         if (inside < params.parked_prefer_fraction * static_cast<double>(r.blobs[i].size())) continue;
-        objects::Box3& box = (*boxes)[i];
-        const float yaw = static_cast<float>(car.yaw_rad - r.ego_world.yaw_rad);
-        box.center.head<2>() = xy.cast<float>();
-        box.size = Eigen::Vector3f(static_cast<float>(car.length_m), static_cast<float>(car.width_m), box.size.z());
-        SetYaw(&box, yaw, box.axes.col(2));
-        const objects::Classification cls = d.classification;
-        d = car;
-        d.classification = cls;
+        taken[i] = id;
         break;
       }
+    }
+    for (std::size_t i = 0; i < detections->size(); ++i) {
+      // Two cars measured inside one remembered footprint: the memory is wrong (a box across two
+      // neighbours' ends), not both measurements.
+      if (taken[i] < 0 || std::count(taken.begin(), taken.end(), taken[i]) > 1) continue;
+      objects::Detection& d = (*detections)[i];
+      const objects::Detection& car = parked.at(taken[i]);
+      const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(car.xy_m.x(), car.xy_m.y(), 0.0)).head<2>();
+      objects::Box3& box = (*boxes)[i];
+      const float yaw = static_cast<float>(car.yaw_rad - r.ego_world.yaw_rad);
+      box.center.head<2>() = xy.cast<float>();
+      box.size = Eigen::Vector3f(static_cast<float>(car.length_m), static_cast<float>(car.width_m), box.size.z());
+      SetYaw(&box, yaw, box.axes.col(2));
+      const objects::Classification cls = d.classification;
+      d = car;
+      d.classification = cls;
     }
   }
 
@@ -990,8 +1000,8 @@ class Pipeline::Impl {
 
   // Pieces of no class on the ground at the row's front, a car's face wide (wider than a person),
   // at least bay_face_min_range_m away and clear of the cars, are cars seen end-on between their
-  // neighbours; pieces read as a person the same where no walker stood (WalkerNear). Boxed along
-  // the bays from the face, of the Atlas car's mean size (PipelineParams::bay_face_*).
+  // neighbours; pieces read as a person or a rider the same where no walker stood (WalkerNear).
+  // Boxed along the bays from the face, of the Atlas car's mean size (PipelineParams::bay_face_*).
   void CompleteFacesInRow(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
                           std::vector<Seen>* seen) const {
     const objects::ObjectClass& car = atlas.classes()[static_cast<std::size_t>(car_class)];
@@ -1006,10 +1016,10 @@ class Pipeline::Impl {
     for (std::size_t i = 0; i < r.boxes.size(); ++i) {
       Seen& v = (*seen)[i];
       const int cls = v.viewed.classification.class_index;
-      if (!v.on_ground || (cls != atlas.unknown_index() && (cls != pedestrian_class || pedestrian_class < 0))) {
-        continue;
-      }
-      if (cls == pedestrian_class) {
+      // A car's end seen edge-on is as long and wide as a bicycle (the Atlas cyclist).
+      const bool person_or_rider = cls >= 0 && (cls == pedestrian_class || cls == cyclist_class);
+      if (!v.on_ground || (cls != atlas.unknown_index() && !person_or_rider)) continue;
+      if (person_or_rider) {
         const Eigen::Vector3f c = v.viewed.box.center;
         if (WalkerNear((r.T_world_vehicle * Eigen::Vector3d(c.x(), c.y(), 0.0)).head<2>())) continue;
       }
@@ -1183,6 +1193,7 @@ class Pipeline::Impl {
   std::vector<int> stacked_classes;  // stacked_merge_classes as atlas indices
   int car_class = atlas.Find("car");  // -1 without one: no parked-car memory
   int pedestrian_class = atlas.Find("pedestrian");
+  int cyclist_class = atlas.Find("cyclist");
   std::map<int, objects::Detection> parked;  // world frame, by track id
   std::map<int, double> parked_view_area;    // of the view each remembers (parked_keep_view_fraction)
   std::set<int> parked_from_steady_view;     // remembered under parked_max_speed_mps (not replaced by others)

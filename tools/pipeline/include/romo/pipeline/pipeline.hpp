@@ -179,7 +179,9 @@ struct PipelineParams {
   /// footprint (grown by parked_footprint_margin_m) takes that footprint when its own completed
   /// box's centre is more than parked_prefer_offset_m away: the neighbours beside the vehicle
   /// during the sideways entry are cut by the field of view to a stretch of their side, boxed
-  /// along the row, while the car was seen whole from the aisle. 1 < fraction turns this off.
+  /// along the row, while the car was seen whole from the aisle. Two cars seen inside one
+  /// remembered footprint keep their own boxes: that memory is wrong (a box laid across two
+  /// neighbours' ends). 1 < fraction turns this off.
   double parked_prefer_fraction = 0.9;
   double parked_prefer_offset_m = 0.5;
   /// ... only when the car's nearest point is at most this far from the vehicle. Farther out the
@@ -257,8 +259,8 @@ struct PipelineParams {
   double bay_snap_min_off_deg = 20.0;
   double bay_snap_max_face_m = 3.0;
   double bay_snap_ground_ratio = 1.2;
-  /// A piece of no class (or read as a person where no walker stood: parked_pieces_walked_m)
-  /// whose front lies from bay_face_front_tolerance_m before the front line to bay_front_m behind
+  /// A piece of no class (or read as a person or a cyclist where no walker stood:
+  /// parked_pieces_walked_m; a car's end seen edge-on is a bicycle's length and width) whose front lies from bay_face_front_tolerance_m before the front line to bay_front_m behind
   /// it, whose face spans bay_face_min_spread_m (wider than a person) to the Atlas car width max
   /// plus bay_face_width_slack_m, at least bay_face_min_range_m away, clear of the cars, and
   /// showing ground inside no more than bay_face_max_ground_ratio times its points, is a car seen
