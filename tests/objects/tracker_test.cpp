@@ -336,21 +336,25 @@ TEST(TrackerTest, GlimpseBeyondTheCompanionGapIsSomeoneElse) {
 }
 
 TEST(TrackerTest, FollowerGivesWayToTheTrackThatSeesItsWalker) {
-  // The hidden walker is seen again from 2 s, whole but 0.7 m off where its follower stands (out
-  // of its gate): a new track takes it. Once that track is confirmed the follower, nearer to it
-  // than two people stand apart, is the same person tracked twice and ends.
+  // The hidden walker is seen again from 2 s on, whole but 0.85 m off where its follower stands: out
+  // of its gate (0.64 m: 13.8 chi-square over the companion's position variance plus the
+  // measurement's), by more than 3 sigma of the detection noise. A new track takes it. Once that
+  // track is confirmed the follower, nearer to it than two people stand apart (1.2 m here, so the
+  // new track's filtered position is well inside it), is the same person tracked twice and ends.
   std::vector<Walker> walkers = GlimpsedPair();
-  walkers[1].glimpse_to_s = 6.0;
-  walkers[1].glimpse_offset = Eigen::Vector2d(0.0, 0.7);
+  walkers[1].hidden_to_s = walkers[1].glimpse_to_s = 9.0;  // seen so to the end
+  walkers[1].glimpse_offset = Eigen::Vector2d(0.0, 0.85);
   walkers[1].glimpse_whole = true;
-  const SceneResult r = RunScene(walkers, 8.0);
+  TrackerParams params;
+  params.companion_standing_min_gap_m = 1.2;
+  const SceneResult r = RunScene(walkers, 8.0, 0.0, params);
   EXPECT_EQ(r.tracks_created, 3);
   // Two tracks on one walker show as a false track each frame; the follower ends when the new
   // track is confirmed (3 hits), so at most 3 frames.
   EXPECT_LE(r.score.false_tracks, 3);
   // Without that (no gap counts as two people standing together), the follower stays beside its
-  // companion until the walker shows at 6 s: a false track every frame from 2 s.
-  TrackerParams kept;
+  // companion to the end: a false track every frame from 2 s.
+  TrackerParams kept = params;
   kept.companion_standing_min_gap_m = 0.0;
   const SceneResult twice = RunScene(walkers, 8.0, 0.0, kept);
   EXPECT_GT(twice.score.false_tracks, r.score.false_tracks + 30);
