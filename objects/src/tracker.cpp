@@ -128,6 +128,7 @@ class Tracker::Impl {
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
   bool Glimpse(const TrackState_& s, const Detection& d) const;
   bool WithinCompanionGap(const TrackState_& s, const Eigen::Vector2d& xy_m) const;
+  std::size_t IndexOf(int track_id) const;  // into states_; states_.size() when gone
   Eigen::Matrix2d GlimpseCov() const;
   bool OccludedTooLong(const TrackState_& s, double stamp_s) const;
   void FollowCompanions(const std::vector<char>& updated, const std::vector<char>& glimpsed, double stamp_s);
@@ -187,11 +188,15 @@ bool Tracker::Impl::Glimpse(const TrackState_& s, const Detection& d) const {
   return d.classification.class_index != pedestrian_ || d.width_m < ped.width.mean_m - ped.width.sigma_m;
 }
 
+std::size_t Tracker::Impl::IndexOf(int track_id) const {
+  std::size_t k = 0;
+  while (k < states_.size() && states_[k].track.id != track_id) ++k;
+  return k;
+}
+
 bool Tracker::Impl::WithinCompanionGap(const TrackState_& s, const Eigen::Vector2d& xy_m) const {
-  for (const TrackState_& c : states_) {
-    if (c.track.id == s.track.companion_id) return (xy_m - c.x.head<2>()).norm() <= params_.companion_max_gap_m;
-  }
-  return true;
+  const std::size_t c = IndexOf(s.track.companion_id);
+  return c == states_.size() || (xy_m - states_[c].x.head<2>()).norm() <= params_.companion_max_gap_m;
 }
 
 Eigen::Matrix2d Tracker::Impl::GlimpseCov() const {
@@ -230,8 +235,7 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, const std
     Track& t = s.track;
     if (glimpsed[i]) {
       // Moved by the glimpse, it walks on with its companion from there.
-      std::size_t c = 0;
-      while (c < states_.size() && states_[c].track.id != t.companion_id) ++c;
+      const std::size_t c = IndexOf(t.companion_id);
       if (c == states_.size()) {
         t.companion_id = -1;
       } else {
@@ -259,8 +263,7 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, const std
       }
     }
     if (t.companion_id < 0) continue;
-    std::size_t c = 0;
-    while (c < states_.size() && states_[c].track.id != t.companion_id) ++c;
+    const std::size_t c = IndexOf(t.companion_id);
     // (Standing close by, the two are as likely one person tracked twice, sharing one blob.)
     const bool stands_close = c < states_.size() && measured(c) && !walks(states_[c]) &&
                               s.companion_offset.norm() < params_.companion_standing_min_gap_m;
