@@ -127,6 +127,8 @@ class Tracker::Impl {
   bool MayHoldSeveral(const Detection& d) const;
   Eigen::Matrix2d MeasurementCov(const Detection& d) const;
   bool Glimpse(const TrackState_& s, const Detection& d) const;
+  void ReservePeopleForPedestrianTracks(const std::vector<Detection>& detections,
+                                        const std::vector<int>& column_detection, Eigen::MatrixXd* cost) const;
   bool WithinCompanionGap(const TrackState_& s, const Eigen::Vector2d& xy_m) const;
   std::size_t IndexOf(int track_id) const;  // into states_; states_.size() when gone
   Eigen::Matrix2d GlimpseCov() const;
@@ -186,6 +188,34 @@ bool Tracker::Impl::Glimpse(const TrackState_& s, const Detection& d) const {
   if (!params_.companion_glimpses || s.track.companion_id < 0) return false;
   const ObjectClass& ped = atlas_.classes()[static_cast<std::size_t>(pedestrian_)];
   return d.classification.class_index != pedestrian_ || d.width_m < ped.width.mean_m - ped.width.sigma_m;
+}
+
+// A track of another class moving faster than anyone walks is no person's: gating a person's
+// detection it would take it, and leave the person's own track a worse one.
+void Tracker::Impl::ReservePeopleForPedestrianTracks(const std::vector<Detection>& detections,
+                                                     const std::vector<int>& column_detection,
+                                                     Eigen::MatrixXd* cost) const {
+  if (!params_.people_for_pedestrian_tracks) return;
+  const double walking_limit = atlas_.classes()[static_cast<std::size_t>(pedestrian_)].max_speed_mps;
+  for (Eigen::Index c = 0; c < cost->cols(); ++c) {
+    if (detections[static_cast<std::size_t>(column_detection[static_cast<std::size_t>(c)])].classification.class_index !=
+        pedestrian_) {
+      continue;
+    }
+    bool person_gates = false;
+    for (std::size_t i = 0; i < states_.size(); ++i) {
+      const Track& t = states_[i].track;
+      person_gates |= t.class_index == pedestrian_ && t.state != TrackState::kTentative &&
+                      (*cost)(static_cast<Eigen::Index>(i), c) < kForbiddenCost;
+    }
+    if (!person_gates) continue;
+    for (std::size_t i = 0; i < states_.size(); ++i) {
+      const TrackState_& s = states_[i];
+      if (s.track.class_index != pedestrian_ && s.x.tail<2>().norm() > walking_limit) {
+        (*cost)(static_cast<Eigen::Index>(i), c) = kForbiddenCost;
+      }
+    }
+  }
 }
 
 std::size_t Tracker::Impl::IndexOf(int track_id) const {
@@ -388,6 +418,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
       cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = value;
     }
   }
+  ReservePeopleForPedestrianTracks(detections, column_detection, &cost);
   const Assignment assignment = SolveAssignment(cost);
 
   std::vector<std::vector<int>> members(detections.size());

@@ -360,6 +360,53 @@ TEST(TrackerTest, FollowerGivesWayToTheTrackThatSeesItsWalker) {
   EXPECT_GT(twice.score.false_tracks, r.score.false_tracks + 30);
 }
 
+// A piece of a parked car (a blob of no class) tracked on stereo noise takes a velocity of 3 m/s
+// and coasts onto a walker as the walker turns toward it (the simulated scene at 2.7 Hz: seed 5,
+// frame 16). The walker's detection stays the walker's track's (people_for_pedestrian_tracks):
+// without the rule the piece's track, predicted onto it, takes it, and the walker's track takes a
+// sliver beside the walker where it expected the walker (and then walks off with the piece's
+// velocity).
+TEST(TrackerTest, APersonsDetectionGoesToThePersonsTrack) {
+  const Atlas atlas = LoadAtlas();
+  constexpr double kSceneFrameS = 0.37;
+  constexpr int kTurn = 6;  // the walker turns, and the piece's track reaches it
+  const Eigen::Vector2d turned(0.45, 2.0);
+  auto walker_at = [&](int frame) -> Eigen::Vector2d {
+    return frame < kTurn ? Eigen::Vector2d(0.0, 1.0) * frame * kSceneFrameS : turned;
+  };
+  auto piece_at = [&](int frame) -> Eigen::Vector2d {
+    return turned + Eigen::Vector2d(3.0, 0.0) * (kTurn - frame) * kSceneFrameS;
+  };
+  // The walker's detection index at the turn taken by its track (the sliver is detection 1).
+  auto run = [&](const TrackerParams& params) {
+    Tracker tracker(atlas, params);
+    int walker_track = -1;
+    for (int frame = 0; frame <= kTurn; ++frame) {
+      std::vector<Detection> detections;
+      detections.push_back(PedestrianBlob(atlas, walker_at(frame), 0.0, 0.6, 0.4));
+      if (frame <= kTurn - 2) {  // then hidden: coasting
+        Detection piece = PedestrianBlob(atlas, piece_at(frame), 0.0, 0.9, 0.4);
+        piece.height_m = 0.8;
+        piece.classification = atlas.Classify(piece.length_m, piece.width_m, piece.height_m);
+        detections.push_back(piece);
+      }
+      if (frame == kTurn) {  // where the walker's track expects the walker
+        detections.push_back(PedestrianBlob(atlas, Eigen::Vector2d(0.0, kTurn * kSceneFrameS), 0.0, 0.3, 0.05));
+      }
+      const std::vector<Track>& tracks = tracker.Update(frame * kSceneFrameS, detections);
+      for (const Track& t : tracks) {
+        if (frame == 0 && t.detection_index == 0) walker_track = t.id;
+        if (frame == kTurn && t.id == walker_track) return t.detection_index;
+      }
+    }
+    return -2;
+  };
+  TrackerParams any_track;
+  any_track.people_for_pedestrian_tracks = false;
+  EXPECT_EQ(run(any_track), 1) << "the case this guards: the walker's track takes the sliver";
+  EXPECT_EQ(run(TrackerParams{}), 0) << "the walker's detection";
+}
+
 TEST(TrackerTest, MergedPedestriansBothSurviveAndSplit) {
   // Two walkers pass each other head-on 0.6 m apart: for ~0.6 s stereo sees one blob
   // (Fig. 4.16 bottom); both tracks must share it and come out with their own ids.

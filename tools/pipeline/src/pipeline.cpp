@@ -282,8 +282,9 @@ void PipelineParams::Validate() const {
     Fail("pipeline: parked_prefer_* out of range (offset " + std::to_string(parked_prefer_offset_m) +
          " m >= 0, max range " + std::to_string(parked_prefer_max_range_m) + " m >= 0)");
   }
-  if (!(tandem_min_length_m >= 0)) {
-    Fail("pipeline: tandem_min_length_m must be >= 0, got " + std::to_string(tandem_min_length_m));
+  if (!(tandem_min_length_m >= 0) || !(aisle_pair_min_gap_m >= 0)) {
+    Fail("pipeline: tandem_min_length_m and aisle_pair_min_gap_m must be >= 0, got " +
+         std::to_string(tandem_min_length_m) + " m, " + std::to_string(aisle_pair_min_gap_m) + " m");
   }
   if (!(framed_min_length_m >= 0) || !(framed_occluder_margin_m >= 0) ||
       !(framed_end_gap_deg > 0 && framed_end_gap_deg < 45)) {
@@ -502,8 +503,10 @@ class Pipeline::Impl {
       }
       for (const auto& [id, car] : parked) {
         const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(car.xy_m.x(), car.xy_m.y(), 0.0)).head<2>();
+        // A memory narrower than the Atlas car was a partial view: its side may lie beyond it.
+        const double width = std::max(car.width_m, atlas.classes()[static_cast<std::size_t>(car_class)].width.mean_m);
         const int inside = PointsInsideFootprint(r.cloud, r.blobs[i], xy, car.yaw_rad - r.ego_world.yaw_rad,
-                                                 0.5 * car.length_m + m, 0.5 * car.width_m + m);
+                                                 0.5 * car.length_m + m, 0.5 * width + m);
         if (inside < params.parked_prefer_fraction * static_cast<double>(r.blobs[i].size())) continue;
         taken[i] = id;
         break;
@@ -866,10 +869,13 @@ class Pipeline::Impl {
   }
 
   // Cars placed by the paint of the row they stand in (PipelineParams::bays_from_paint).
-  void PlaceCarsInRow(FrameResult& r, const Eigen::Vector3f& up, std::vector<Seen>* seen) const {
+  void PlaceCarsInRow(FrameResult& r, const Eigen::Vector3f& up, std::vector<Eigen::Vector2f>* viewers,
+                      std::vector<Seen>* seen) const {
     if (!params.bays_from_paint || car_class < 0) return;
     const std::optional<mapping::BayRow> row = mapping::FindBayRow(r.cloud, r.ground_indices, params.bay_row);
     if (!row) return;
+    SplitPairsInAisle(r, up, *row, viewers, seen);
+    SplitRowFaces(r, up, *row, viewers, seen);
     SnapCarsToBays(r, up, *row, seen);
     CompleteFacesInRow(r, up, *row, seen);
   }
@@ -904,6 +910,12 @@ class Pipeline::Impl {
     face.lo_m = Percentile(alongs, 0.05);
     face.hi_m = Percentile(alongs, 0.95);
     return face;
+  }
+
+  // Whether @p face's front lies on the row's front line, from bay_face_front_tolerance_m before it
+  // to bay_front_m behind it.
+  bool AtRowFront(const RowFace& face) const {
+    return face.front_m >= -params.bay_face_front_tolerance_m && face.front_m <= params.bay_front_m;
   }
 
   // @p box moved to @p xy (vehicle frame), its footprint @p length_m x @p width_m, turned to
@@ -998,6 +1010,75 @@ class Pipeline::Impl {
     }
   }
 
+  // A pedestrian-tall blob standing in the aisle (PipelineParams::aisle_pair_min_gap_m in front of
+  // the row's front line), read as no person but as long as two people side by side, is split in
+  // two along its length when both halves are people. Away from the row no parked car's end
+  // stands there to be split; SplitTandems leaves blobs long across the sight line whole for that.
+  void SplitPairsInAisle(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
+                         std::vector<Eigen::Vector2f>* viewers, std::vector<Seen>* seen) const {
+    if (params.aisle_pair_min_gap_m <= 0.0 || params.tandem_min_length_m <= 0.0 || pedestrian_class < 0) return;
+    const objects::ObjectClass& ped = atlas.classes()[static_cast<std::size_t>(pedestrian_class)];
+    const std::size_t n = r.boxes.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Seen& v = (*seen)[i];
+      const objects::Box3& box = r.boxes[i];
+      if (!v.on_ground || v.viewed.classification.class_index == pedestrian_class ||
+          !ped.height.Contains(box.size.z()) || box.size.x() - v.depth_spread_m < params.tandem_min_length_m ||
+          box.size.x() > 2.0 * ped.length.max_m || box.size.y() > ped.length.max_m ||
+          FaceOf(RowPoints(r, r.blobs[i], row)).front_m > -params.aisle_pair_min_gap_m) {
+        continue;
+      }
+      SplitWhenBothAre(pedestrian_class, i, SplitAlong(r.cloud, r.blobs[i], box.axes.col(0)), r, up, viewers, seen);
+    }
+  }
+
+  // A piece of no class at the row's front whose face is wider than any car's end (what
+  // CompleteFacesInRow takes) and at most two of them is the ends of two neighbours seen along the
+  // row, joined by stereo's smear along the sight line: it is split where its points thin out
+  // along the row (the gap between the cars), each part at least a face (bay_face_min_spread_m).
+  void SplitRowFaces(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
+                     std::vector<Eigen::Vector2f>* viewers, std::vector<Seen>* seen) const {
+    if (!params.split_row_faces) return;
+    const double widest_end = atlas.classes()[static_cast<std::size_t>(car_class)].width.max_m +
+                              params.bay_face_width_slack_m;
+    const Eigen::Vector3f along(static_cast<float>(row.along.x()), static_cast<float>(row.along.y()), 0.0f);
+    const double bay_heading = row.HeadingRad();
+    const std::size_t n = r.boxes.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      // Read as a car seen side-on lying along the front line it is no parked car either: parked
+      // cars stand across that line.
+      const Seen& v = (*seen)[i];
+      const bool side_along_front =
+          v.on_ground && v.viewed.classification.class_index == car_class &&
+          AxisAngle(r.boxes[i].yaw_rad, bay_heading) > kPi / 2.0 - params.bay_snap_min_off_deg * kPi / 180.0;
+      if (!Unclassified(v) && !side_along_front) continue;
+      const RowFace face = FaceOf(RowPoints(r, r.blobs[i], row));
+      const double spread = face.hi_m - face.lo_m;
+      if (!AtRowFront(face) || spread <= widest_end || spread > 2.0 * widest_end) {
+        continue;
+      }
+      const std::vector<float> gaps = SparseStretches(r.cloud, r.blobs[i], along,
+                                                      static_cast<float>(params.bay_face_min_spread_m),
+                                                      params.face_pair_gap_density);
+      // The sparsest stretch leaving no part wider than a car's end.
+      for (float gap : gaps) {
+        std::array<std::vector<int>, 2> parts;
+        for (int p : r.blobs[i]) parts[along.dot(r.cloud.xyz.col(p)) < gap ? 0 : 1].push_back(p);
+        if (std::any_of(parts.begin(), parts.end(), [&](const std::vector<int>& part) {
+              if (part.empty()) return true;
+              const RowFace part_face = FaceOf(RowPoints(r, part, row));
+              return part_face.hi_m - part_face.lo_m > widest_end;
+            })) {
+          continue;
+        }
+        const std::optional<std::array<Part, 2>> seen_parts = SeeParts(i, parts, r, up, *viewers);
+        if (!seen_parts) continue;
+        ReplaceByParts(i, std::move(parts), *seen_parts, r, viewers, seen);
+        break;
+      }
+    }
+  }
+
   // Pieces of no class on the ground at the row's front, a car's face wide (wider than a person),
   // at least bay_face_min_range_m away and clear of the cars, are cars seen end-on between their
   // neighbours; pieces read as a person or a rider the same where no walker stood (WalkerNear).
@@ -1025,8 +1106,8 @@ class Pipeline::Impl {
       }
       const RowFace face = FaceOf(RowPoints(r, r.blobs[i], row));
       const double spread = face.hi_m - face.lo_m;
-      if (face.front_m < -params.bay_face_front_tolerance_m || face.front_m > params.bay_front_m ||
-          spread < params.bay_face_min_spread_m || spread > car.width.max_m + params.bay_face_width_slack_m) {
+      if (!AtRowFront(face) || spread < params.bay_face_min_spread_m ||
+          spread > car.width.max_m + params.bay_face_width_slack_m) {
         continue;
       }
       const double lateral = 0.5 * (face.lo_m + face.hi_m);
@@ -1407,7 +1488,7 @@ FrameResult Pipeline::ProcessClouds(std::int64_t stamp_ns, std::int64_t frame_se
   s.SplitTandems(r, up, &viewers, &seen);
   s.UnclassifyFramedFaces(r, viewers, &seen);
   s.AlignCarsToRow(r, up, viewers, &seen);
-  s.PlaceCarsInRow(r, up, &seen);
+  s.PlaceCarsInRow(r, up, &viewers, &seen);
   std::vector<objects::Detection> detections;
   const std::vector<objects::Box3> measured_boxes = r.boxes;  // before completion
   auto world_detection = [&](const objects::Box3& box, const objects::Classification& cls) {

@@ -111,6 +111,13 @@ struct TrackerParams {
   /// front), so a full update took a velocity error of a metre a second from it and broke the
   /// pair. A glimpse farther than companion_max_gap_m from the companion is someone else's.
   bool companion_glimpses = true;
+  /// A detection read as a pedestrian that a pedestrian track (past tentative) gates is not taken
+  /// by a track of another class moving faster than the Atlas pedestrian's max_speed_mps: no
+  /// person's, such a track (a piece of a parked car coasting on 3 m/s taken from stereo noise)
+  /// took a walker's detection as the walker turned and left the walker's track a sliver beside
+  /// it (simulated scene, full resolution, seed 5 frame 16). Slower tracks of another class may
+  /// be a person not yet voted one (half resolution, seed 10).
+  bool people_for_pedestrian_tracks = true;
   PredictorParams predictor;           ///< path prediction for predict_path classes
   /// @throws romo::Error naming the field and value.
   void Validate() const;

@@ -92,6 +92,13 @@ struct PipelineParams {
   /// (a sliver beside it, or legs below it), can be one partly seen (PartlySeenPerson): the far
   /// one is then a pedestrian too, its box from the ground up. false = both must read as people.
   bool tandem_far_partly_seen = true;
+  /// ... and one read as no person, as long as two people side by side (up to twice the Atlas
+  /// pedestrian length max, no deeper than that max) and standing at least aisle_pair_min_gap_m in
+  /// front of the row's front line (bays_from_paint), is split in two along its length when both
+  /// halves are people, however it is seen: no parked car's end stands in the aisle (the
+  /// simulated scene's pair walking side by side 1.3 m apart, read as a car's end or a cyclist
+  /// 5-10 m away). 0 = off.
+  double aisle_pair_min_gap_m = 1.0;
   /// A blob at least this long seen across its length (the sight line nearer its width than its
   /// length) is split at the emptiest stretch inside it (or the next emptiest, and so on) holding
   /// less than face_pair_gap_density of the blob's median points per length where both parts are cars: the
@@ -266,6 +273,14 @@ struct PipelineParams {
   /// showing ground inside no more than bay_face_max_ground_ratio times its points, is a car seen
   /// end-on between its neighbours: boxed along the bays from its face with the Atlas car's mean
   /// size and score bay_face_score.
+  /// ... and a piece there of no class (or read as a car seen side-on lying along the front line,
+  /// across which parked cars stand) whose face is wider than that, and at most twice, is the ends
+  /// of two neighbours seen along the row, joined by stereo's smear along the sight line: it is
+  /// split at the sparsest stretch along the row (face_pair_gap_density) that leaves each part at
+  /// least bay_face_min_spread_m and no wider than a car's end, before the parts are completed
+  /// (the simulated scene's cars 106 and 107, seed 2, frames 8-12: one piece 3.6-4.4 m across).
+  /// false = such pieces stay whole.
+  bool split_row_faces = true;
   double bay_face_front_tolerance_m = 0.3;
   double bay_face_min_spread_m = 0.6;
   double bay_face_width_slack_m = 0.3;
