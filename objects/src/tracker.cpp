@@ -197,6 +197,14 @@ void Tracker::Impl::ReservePeopleForPedestrianTracks(const std::vector<Detection
                                                      Eigen::MatrixXd* cost) const {
   if (!params_.people_for_pedestrian_tracks) return;
   const double walking_limit = atlas_.classes()[static_cast<std::size_t>(pedestrian_)].max_speed_mps;
+  std::vector<Eigen::Index> no_person;  // rows of tracks of another class, faster than a walker
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    const TrackState_& s = states_[i];
+    if (s.track.class_index != pedestrian_ && s.x.tail<2>().norm() > walking_limit) {
+      no_person.push_back(static_cast<Eigen::Index>(i));
+    }
+  }
+  if (no_person.empty()) return;
   for (Eigen::Index c = 0; c < cost->cols(); ++c) {
     if (detections[static_cast<std::size_t>(column_detection[static_cast<std::size_t>(c)])].classification.class_index !=
         pedestrian_) {
@@ -209,12 +217,7 @@ void Tracker::Impl::ReservePeopleForPedestrianTracks(const std::vector<Detection
                       (*cost)(static_cast<Eigen::Index>(i), c) < kForbiddenCost;
     }
     if (!person_gates) continue;
-    for (std::size_t i = 0; i < states_.size(); ++i) {
-      const TrackState_& s = states_[i];
-      if (s.track.class_index != pedestrian_ && s.x.tail<2>().norm() > walking_limit) {
-        (*cost)(static_cast<Eigen::Index>(i), c) = kForbiddenCost;
-      }
-    }
+    for (Eigen::Index i : no_person) (*cost)(i, c) = kForbiddenCost;
   }
 }
 

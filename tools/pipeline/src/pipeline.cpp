@@ -157,6 +157,14 @@ std::array<std::vector<int>, 2> SplitAlong(const PointCloud& cloud, const std::v
   return halves;
 }
 
+// @p blob in two at @p at along @p axis: the points before it, and the rest.
+std::array<std::vector<int>, 2> SplitAt(const PointCloud& cloud, const std::vector<int>& blob, const Eigen::Vector3f& axis,
+                                        float at) {
+  std::array<std::vector<int>, 2> parts;
+  for (int p : blob) parts[axis.dot(cloud.xyz.col(p)) < at ? 0 : 1].push_back(p);
+  return parts;
+}
+
 // Where along @p axis the points of @p blob thin out, at least @p margin_m inside both ends: the
 // middles of the stretches (0.1 m bins, averaged over 0.3 m) holding less than @p max_density of
 // the blob's median bin, sparsest first, one per stretch.
@@ -490,6 +498,7 @@ class Pipeline::Impl {
     if (params.parked_prefer_fraction > 1.0 || parked.empty()) return;
     const Eigen::Isometry3d T_vehicle_world = r.T_world_vehicle.inverse();
     const double m = params.parked_footprint_margin_m;
+    const double mean_car_width = atlas.classes()[static_cast<std::size_t>(car_class)].width.mean_m;
     std::vector<int> taken(detections->size(), -1);  // the remembered car each detection lies in
     for (std::size_t i = 0; i < detections->size(); ++i) {
       const objects::Detection& d = (*detections)[i];
@@ -504,7 +513,7 @@ class Pipeline::Impl {
       for (const auto& [id, car] : parked) {
         const Eigen::Vector2d xy = (T_vehicle_world * Eigen::Vector3d(car.xy_m.x(), car.xy_m.y(), 0.0)).head<2>();
         // A memory narrower than the Atlas car was a partial view: its side may lie beyond it.
-        const double width = std::max(car.width_m, atlas.classes()[static_cast<std::size_t>(car_class)].width.mean_m);
+        const double width = std::max(car.width_m, mean_car_width);
         const int inside = PointsInsideFootprint(r.cloud, r.blobs[i], xy, car.yaw_rad - r.ego_world.yaw_rad,
                                                  0.5 * car.length_m + m, 0.5 * width + m);
         if (inside < params.parked_prefer_fraction * static_cast<double>(r.blobs[i].size())) continue;
@@ -898,6 +907,7 @@ class Pipeline::Impl {
     double front_m = 0.0;
     double lo_m = 0.0;
     double hi_m = 0.0;
+    double spread_m() const { return hi_m - lo_m; }
   };
   RowFace FaceOf(const std::vector<Eigen::Vector2d>& points) const {
     std::vector<double> depths, alongs;
@@ -910,6 +920,12 @@ class Pipeline::Impl {
     face.lo_m = Percentile(alongs, 0.05);
     face.hi_m = Percentile(alongs, 0.95);
     return face;
+  }
+
+  // The widest a car's end seen at the row's front may be: the Atlas car width max plus
+  // bay_face_width_slack_m.
+  double WidestCarEnd() const {
+    return atlas.classes()[static_cast<std::size_t>(car_class)].width.max_m + params.bay_face_width_slack_m;
   }
 
   // Whether @p face's front lies on the row's front line, from bay_face_front_tolerance_m before it
@@ -985,7 +1001,7 @@ class Pipeline::Impl {
         lateral = std::clamp(lateral, lo + 0.5 * width, hi - 0.5 * width);
         if (std::abs(row.Along(centre) - lateral) <= params.bay_snap_min_offset_m && !off_heading) continue;
       } else {
-        if (!off_heading || face.hi_m - face.lo_m > params.bay_snap_max_face_m) continue;  // (several cars' faces)
+        if (!off_heading || face.spread_m() > params.bay_snap_max_face_m) continue;  // (several cars' faces)
         width = std::min(width, car.width.mean_m);
       }
       std::vector<double> depths;
@@ -1039,8 +1055,7 @@ class Pipeline::Impl {
   void SplitRowFaces(FrameResult& r, const Eigen::Vector3f& up, const mapping::BayRow& row,
                      std::vector<Eigen::Vector2f>* viewers, std::vector<Seen>* seen) const {
     if (!params.split_row_faces) return;
-    const double widest_end = atlas.classes()[static_cast<std::size_t>(car_class)].width.max_m +
-                              params.bay_face_width_slack_m;
+    const double widest_end = WidestCarEnd();
     const Eigen::Vector3f along(static_cast<float>(row.along.x()), static_cast<float>(row.along.y()), 0.0f);
     const double bay_heading = row.HeadingRad();
     const std::size_t n = r.boxes.size();
@@ -1053,7 +1068,7 @@ class Pipeline::Impl {
           AxisAngle(r.boxes[i].yaw_rad, bay_heading) > kPi / 2.0 - params.bay_snap_min_off_deg * kPi / 180.0;
       if (!Unclassified(v) && !side_along_front) continue;
       const RowFace face = FaceOf(RowPoints(r, r.blobs[i], row));
-      const double spread = face.hi_m - face.lo_m;
+      const double spread = face.spread_m();
       if (!AtRowFront(face) || spread <= widest_end || spread > 2.0 * widest_end) {
         continue;
       }
@@ -1062,12 +1077,10 @@ class Pipeline::Impl {
                                                       params.face_pair_gap_density);
       // The sparsest stretch leaving no part wider than a car's end.
       for (float gap : gaps) {
-        std::array<std::vector<int>, 2> parts;
-        for (int p : r.blobs[i]) parts[along.dot(r.cloud.xyz.col(p)) < gap ? 0 : 1].push_back(p);
+        std::array<std::vector<int>, 2> parts = SplitAt(r.cloud, r.blobs[i], along, gap);
         if (std::any_of(parts.begin(), parts.end(), [&](const std::vector<int>& part) {
               if (part.empty()) return true;
-              const RowFace part_face = FaceOf(RowPoints(r, part, row));
-              return part_face.hi_m - part_face.lo_m > widest_end;
+              return FaceOf(RowPoints(r, part, row)).spread_m() > widest_end;
             })) {
           continue;
         }
@@ -1105,9 +1118,8 @@ class Pipeline::Impl {
         if (WalkerNear((r.T_world_vehicle * Eigen::Vector3d(c.x(), c.y(), 0.0)).head<2>())) continue;
       }
       const RowFace face = FaceOf(RowPoints(r, r.blobs[i], row));
-      const double spread = face.hi_m - face.lo_m;
-      if (!AtRowFront(face) || spread < params.bay_face_min_spread_m ||
-          spread > car.width.max_m + params.bay_face_width_slack_m) {
+      const double spread = face.spread_m();
+      if (!AtRowFront(face) || spread < params.bay_face_min_spread_m || spread > WidestCarEnd()) {
         continue;
       }
       const double lateral = 0.5 * (face.lo_m + face.hi_m);
@@ -1151,9 +1163,9 @@ class Pipeline::Impl {
           r.cloud, r.blobs[i], box.axes.col(0), 0.5f * static_cast<float>(car.width.min_m), params.face_pair_gap_density);
       const objects::Box3 whole = box;  // (r.boxes grows on a split)
       for (float gap : gaps) {
-        std::array<std::vector<int>, 2> parts;
-        for (int p : r.blobs[i]) parts[whole.axes.col(0).dot(r.cloud.xyz.col(p)) < gap ? 0 : 1].push_back(p);
-        if (SplitWhenBothAre(car_class, i, std::move(parts), r, up, viewers, seen)) break;
+        if (SplitWhenBothAre(car_class, i, SplitAt(r.cloud, r.blobs[i], whole.axes.col(0), gap), r, up, viewers, seen)) {
+          break;
+        }
       }
     }
   }
