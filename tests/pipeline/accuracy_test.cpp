@@ -1,23 +1,24 @@
-// Accuracy of the whole stack on the simulated parking scene `romo run` uses (40 frames, half
-// resolution), over seeds 1-5 (seed 1 is `romo run`'s default), and of seed 1 at full resolution:
-// detection, boxes, tracks and the parking slot against the scene's ground truth, scored by
-// `romo eval scene`.
+// Accuracy of the whole stack on the simulated parking scene `romo run` uses (40 frames), over
+// seeds 1-5 (seed 1 is `romo run`'s default): detection, boxes, tracks and the parking slot against
+// the scene's ground truth, scored by `romo eval scene`.
 //
-// One seed's figures move by several sightings with any change to the stack (which blob a track
-// takes, which view a parked car is remembered from); the mean over five scenes is what a change
-// is judged by. Where the issue's targets are met (slot centre within 0.15 m and yaw within 3
-// degrees, the too-narrow bay never reported feasible) they are asserted in every scene. Where they
-// are not yet met (car and pedestrian recall/precision >= 0.95, box centre within 0.2 m, the bay
-// found in every frame it is fully visible; see
-// README "Accuracy") today's five-seed means are asserted as floors a little below the figures
-// measured, so that a change that loses accuracy fails here instead of passing unnoticed. Each
-// run is deterministic for a build (fixed seed, rendering and matching independent of thread
-// count); the margins cover compiler and library differences in floating point.
+// At the rigs' own resolution (`--scale 1`) every target of the issue is met over the five scenes
+// pooled, and asserted as the issue states it. At `romo run`'s default half resolution (a quarter of
+// the stereo work, twice the depth noise) the slot's targets are asserted in every scene; the
+// recall, precision and box-centre targets are not yet met there, so today's five-seed means are
+// asserted as floors a little below the figures measured, so that a change that loses accuracy fails
+// here instead of passing unnoticed (README "Accuracy"). One seed's figures move by several
+// sightings with any change to the stack (which blob a track takes, which view a parked car is
+// remembered from); the five scenes together are what a change is judged by. Each run is
+// deterministic for a build (fixed seed, rendering and matching independent of thread count).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <future>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -223,31 +224,61 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
 }
 
 // The rigs' own resolution (782x582: half the depth noise of the default, four times the stereo
-// work), seed 1 only to keep CI short. Here more of the issue's targets are met, and asserted:
-// car and pedestrian precision >= 0.95, box centre within 0.2 m, the bay found in every frame it
-// is fully visible; the others are floors a little under seed 1's figures (car P 0.973 R 0.960,
-// pedestrian P 0.973 R 0.934, centre 0.188 m, slot 32/32 at 0.053 m, session 34; seeds 1-5 pooled
-// meet every target: README "Accuracy"; car recall was 0.665 before
-// parked cars were placed by their row's paint, session 25; pedestrians 0.955 / 0.760 before boxes
-// stood on the ground, session 28, 0.982 / 0.857 before the far one of a pair in single file was
-// kept from a sliver and a hidden walker waited with its companion, session 30; car recall 0.947
-// before a car's end read as a cyclist at the row's front was placed as a car, session 33).
-TEST(AccuracyTest, FullResolutionSceneMeetsMoreTargets) {
-  romo::test::ScratchDir dir;
-  const auto run = romo::test::RunRomo("run --no-pictures --scale 1 --seed 1 --out " + dir.path());
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const SceneEval e = EvaluateSceneLog(dir / "outputs.lcmlog");
-  PrintSceneFigures("seed 1 at full resolution", e);
-  ASSERT_EQ(e.frames, 40);
-  EXPECT_EQ(e.narrow_reported_feasible(), 0);
-  EXPECT_EQ(e.slot_found_frames, e.slot_visible_frames);
-  EXPECT_LE(e.slot_center_err_m, 0.15);
-  EXPECT_LE(e.slot_yaw_err_deg, 3.0);
-  EXPECT_LE(e.box_center_err_m_median, 0.2);
-  EXPECT_GE(e.car.precision(), 0.95);
-  EXPECT_GE(e.car.recall(), 0.94);
-  EXPECT_GE(e.pedestrian.precision(), 0.95);
-  EXPECT_GE(e.pedestrian.recall(), 0.91);  // 0.934 (183/196) since the follower walks on with its hidden companion
+// work), seeds 1-5 pooled, where every target of the issue is met and asserted as it stands: cars
+// and pedestrians within 15 m at precision and recall >= 0.95, the box centre within 0.2 m
+// (median), the feasible bay found in every frame it is fully visible, its centre within 0.15 m and
+// yaw within 3 degrees, the too-narrow bay never reported feasible. Pooled because one scene moves
+// by several sightings with any change (seed 1 alone: pedestrian recall 0.934, seed 4 0.928) while
+// the issue's figures are about the stack, not one scene. Session 34: cars 0.975 / 0.958,
+// pedestrians 0.986 / 0.951 (922 of 970 sightings), centre 0.190 m, slot 160/160 at 0.057 m and
+// 0.65 deg. Before (seed 1 only, floors): car recall 0.665 before parked cars were placed by their
+// row's paint, session 25; pedestrians 0.955 / 0.760 before boxes stood on the ground, session 28,
+// 0.982 / 0.857 before the far one of a pair in single file was kept from a sliver and a hidden
+// walker waited with its companion, session 30; car recall 0.947 before a car's end read as a
+// cyclist at the row's front was placed as a car, session 33. The five 40-frame runs take about
+// 12 CPU minutes, two at a time.
+TEST(AccuracyTest, FullResolutionScenesMeetTheIssuesTargets) {
+  std::vector<std::unique_ptr<romo::test::ScratchDir>> dirs;
+  for (int i = 0; i < kSeeds; ++i) dirs.push_back(std::make_unique<romo::test::ScratchDir>());
+  // Two runs at a time: each keeps about 1.7 of 2 cores busy, so a pair fills the machine.
+  std::vector<romo::test::CommandResult> results(kSeeds);
+  std::atomic<int> next{0};
+  const auto run_seeds = [&] {
+    for (int i = next++; i < kSeeds; i = next++) {
+      results[static_cast<std::size_t>(i)] = romo::test::RunRomo(
+          "run --no-pictures --lcm-url '' --scale 1 --seed " + std::to_string(i + 1) + " --out " +
+          dirs[static_cast<std::size_t>(i)]->path());
+    }
+  };
+  auto other = std::async(std::launch::async, run_seeds);
+  run_seeds();
+  other.get();
+  std::vector<std::string> logs;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const auto& result = results[static_cast<std::size_t>(seed - 1)];
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    logs.push_back(*dirs[static_cast<std::size_t>(seed - 1)] / "outputs.lcmlog");
+    const SceneEval e = EvaluateSceneLog(logs.back());
+    PrintSceneFigures("seed " + std::to_string(seed) + " at full resolution", e);
+    ASSERT_EQ(e.frames, 40);
+    EXPECT_EQ(e.narrow_reported_feasible(), 0) << e.MissesText();
+    EXPECT_EQ(e.slot_found_frames, e.slot_visible_frames) << e.MissesText();
+    EXPECT_LE(e.slot_center_err_m, 0.15);
+    EXPECT_LE(e.slot_yaw_err_deg, 3.0);
+  }
+  const SceneEval pooled = EvaluateSceneLogs(logs);
+  PrintSceneFigures("seeds 1-5 at full resolution, pooled", pooled);
+  ASSERT_EQ(pooled.frames, 40 * kSeeds);
+  EXPECT_GE(pooled.car.precision(), 0.95);
+  EXPECT_GE(pooled.car.recall(), 0.95);
+  EXPECT_GE(pooled.pedestrian.precision(), 0.95);
+  EXPECT_GE(pooled.pedestrian.recall(), 0.95);
+  EXPECT_LE(pooled.box_center_err_m_median, 0.2);
+  EXPECT_EQ(pooled.slot_found_frames, pooled.slot_visible_frames);
+  EXPECT_LE(pooled.slot_center_err_m, 0.15);
+  EXPECT_LE(pooled.slot_yaw_err_deg, 3.0);
+  EXPECT_EQ(pooled.narrow_reported_feasible(), 0);
 }
 
 }  // namespace
