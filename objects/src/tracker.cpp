@@ -134,7 +134,7 @@ class Tracker::Impl {
   Eigen::Matrix2d GlimpseCov() const;
   bool OccludedTooLong(const TrackState_& s, double stamp_s) const;
   void FollowCompanions(const std::vector<char>& updated, const std::vector<char>& glimpsed, double stamp_s);
-  void Observe(TrackState_* s, const Detection& d, double stamp_s) const;
+  void Observe(TrackState_* s, const Detection& d, double stamp_s, bool glimpse = false) const;
 };
 
 void Tracker::Impl::Predict(TrackState_* s, double dt) const {
@@ -325,10 +325,12 @@ void Tracker::Impl::FollowCompanions(const std::vector<char>& updated, const std
   }
 }
 
-void Tracker::Impl::Observe(TrackState_* s, const Detection& d, double stamp_s) const {
+void Tracker::Impl::Observe(TrackState_* s, const Detection& d, double stamp_s, bool glimpse) const {
   Track& t = s->track;
   const int c = d.classification.class_index;
-  if (c >= 0 && c < static_cast<int>(s->votes.size())) {
+  // A glimpse (a sliver of a follower hidden in part) says where the person is, not what: its
+  // class is the part's, and a few of them would outvote the person.
+  if (!glimpse && c >= 0 && c < static_cast<int>(s->votes.size())) {
     ++s->votes[static_cast<std::size_t>(c)];
     s->vote_score[static_cast<std::size_t>(c)] += d.classification.score;
     // Majority of the votes; a real class beats "unknown" on a tie.
@@ -437,7 +439,7 @@ const std::vector<Track>& Tracker::Impl::Update(double stamp_s,
       const bool glimpse = Glimpse(s, d);
       glimpsed[static_cast<std::size_t>(members[j][0])] = glimpse ? 1 : 0;
       KalmanUpdate(&s, d.xy_m, glimpse ? GlimpseCov() : R[j]);
-      Observe(&s, d, stamp_s);
+      Observe(&s, d, stamp_s, glimpse);
       s.track.merged = false;
       s.track.detection_index = static_cast<int>(j);
       updated[static_cast<std::size_t>(members[j][0])] = 1;
