@@ -206,6 +206,8 @@ TEST(AccuracyTest, ParkingScenesMeetTheirTargetsOrTodaysFloors) {
   // by side in the aisle split, a walker's detection kept from a faster track of another class, a
   // narrow memory tested at the mean car width): car P 0.950 -> 0.958, R 0.862 -> 0.863,
   // pedestrian P 0.893 -> 0.897, R 0.829 -> 0.824 (hidden 0.54 -> 0.52), centre 0.270 -> 0.265 m.
+  // Session 35 (a follower's glimpses no longer vote its class, the companion gap 2 m): pedestrian
+  // R 0.824 -> 0.827 (hidden 0.52 -> 0.54), centre 0.265 -> 0.266 m.
   EXPECT_GE(mean.car_p, 0.93);
   EXPECT_GE(mean.car_r, 0.84);
   EXPECT_GE(mean.car_visible_r, 0.86);
